@@ -1,0 +1,18 @@
+"""jaxgear: differentiable thermal tribo-dynamic power loss model of spur gear pairs in JAX.
+
+Implements S. Li, "A thermal tribo-dynamic mechanical power loss model for spur gear pairs",
+Tribology International 88 (2015) 170-178, and goes beyond it (implicit gradients, sweeps, fidelity
+ladder). SI units inside. Enable float64 (``jax.config.update("jax_enable_x64", True)``) before use:
+the library never changes ``jax.config`` itself.
+"""
+
+from . import presets as presets
+from . import units as units
+from .gear.geometry import GearGeometry as GearGeometry
+from .gear.geometry import gear_geometry as gear_geometry
+from .gear.pair import Bearings as Bearings
+from .gear.pair import GearPair as GearPair
+from .gear.pair import TipRelief as TipRelief
+from .material import Material as Material
+
+__version__ = "0.1.0"

@@ -1,0 +1,57 @@
+"""The ``jaxgear`` command line.
+
+Each subcommand lives in ``jaxgear/commands/<name>.py`` and exposes ``register(subparsers)``, which adds
+its parser and sets ``func`` (a callable taking the parsed namespace and returning an exit code).
+Invalid input (``ValueError``) ends with a one-line message on stderr and exit code 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+# Subcommand modules, in the order shown by --help.
+COMMANDS = ("mesh",)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="jaxgear",
+        description=(
+            "Differentiable thermal tribo-dynamic power loss model of spur gear pairs "
+            "(S. Li, Tribology International 88, 2015)."
+        ),
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        importlib.import_module(f"jaxgear.commands.{name}").register(sub)
+    return parser
+
+
+def enable_float64() -> None:
+    """The CLI computes in float64 (EHL needs it); the library itself never flips jax.config."""
+    import jax
+
+    jax.config.update("jax_enable_x64", True)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 0
+    enable_float64()
+    try:
+        return int(args.func(args) or 0)
+    except ValueError as err:
+        print(f"jaxgear {args.command}: error: {err}", file=sys.stderr)
+        return 2
+    except FileNotFoundError as err:
+        print(f"jaxgear {args.command}: error: {err}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
