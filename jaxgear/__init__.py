@@ -10,6 +10,11 @@ from . import presets as presets
 from . import units as units
 from .gear.geometry import GearGeometry as GearGeometry
 from .gear.geometry import gear_geometry as gear_geometry
+from .gear.geometry import hertz_half_width as hertz_half_width
+from .gear.geometry import hertz_pressure as hertz_pressure
+from .gear.geometry import kinematics as kinematics
+from .gear.mesh import MeshCycle as MeshCycle
+from .gear.mesh import mesh_cycle as mesh_cycle
 from .gear.pair import Bearings as Bearings
 from .gear.pair import GearPair as GearPair
 from .gear.pair import TipRelief as TipRelief

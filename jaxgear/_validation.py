@@ -82,7 +82,9 @@ def check_non_negative(name: str, value: Any, unit: str = "") -> None:
 def check_choice(name: str, value: Any, choices: tuple) -> None:
     """Raise unless ``value`` is one of ``choices``."""
     if value not in choices:
-        raise ValueError(f"{name} = {value!r} is not valid; valid choices: {', '.join(map(repr, choices))}")
+        raise ValueError(
+            f"{name} = {value!r} is not valid; valid choices: {', '.join(map(repr, choices))}"
+        )
 
 
 def check_float64(name: str, value: Any) -> None:

@@ -28,8 +28,14 @@ class Material(eqx.Module):
 
     def __check_init__(self):
         check_positive("Material.youngs_modulus", self.youngs_modulus, "Pa")
-        check_range("Material.poisson_ratio", self.poisson_ratio, -1.0, 0.5,
-                    low_inclusive=False, high_inclusive=False)
+        check_range(
+            "Material.poisson_ratio",
+            self.poisson_ratio,
+            -1.0,
+            0.5,
+            low_inclusive=False,
+            high_inclusive=False,
+        )
         check_positive("Material.density", self.density, "kg/m^3")
         check_positive("Material.thermal_conductivity", self.thermal_conductivity, "W/(m K)")
         check_positive("Material.specific_heat", self.specific_heat, "J/(kg K)")

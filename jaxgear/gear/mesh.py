@@ -3,7 +3,17 @@
 from __future__ import annotations
 
 import equinox as eqx
+import jax
+import jax.numpy as jnp
 from jaxtyping import Array, Float
+
+from .._validation import check_positive, check_range
+from ..material import reduced_modulus
+from .geometry import GearGeometry, gear_geometry, normal_load, radii_of_curvature
+from .load_sharing import DEFAULT_CONTACT_SMOOTHING, share_load
+from .modification import DEFAULT_RELIEF_SMOOTHING, relief_separation
+from .pair import GearPair
+from .stiffness import pair_stiffness
 
 
 class MeshCycle(eqx.Module):
@@ -54,3 +64,99 @@ class MeshCycle(eqx.Module):
     @property
     def n_positions(self) -> int:
         return self.mesh_fraction.shape[0]
+
+
+def _safe_sqrt(x):
+    positive = x > 0
+    return jnp.where(positive, jnp.sqrt(jnp.where(positive, x, 1.0)), 0.0)
+
+
+def contact_weight(geo: GearGeometry, s, edge_width):
+    """Smooth contact flag (0 … 1) of a contact at LOA position s.
+
+    The weight rises from 0 to 1 over ``edge_width`` (m along the LOA) at each end of the path of
+    contact: a model of the tip edge rounding, which makes the mesh stiffness and static TE continuous
+    in time (a sharp-cornered tooth gives step changes). With edge_width = 0 it is the hard flag.
+    """
+    if edge_width == 0.0:
+        return ((s >= geo.path_start) & (s <= geo.path_end)).astype(jnp.result_type(float))
+    t_in = (s - geo.path_start) / edge_width
+    t_out = (geo.path_end - s) / edge_width
+    return _smoothstep(t_in) * _smoothstep(t_out)
+
+
+def _smoothstep(t):
+    t = jnp.clip(t, 0.0, 1.0)
+    return t * t * t * (t * (6.0 * t - 15.0) + 10.0)  # C² quintic
+
+
+def mesh_cycle(
+    pair: GearPair,
+    torque,
+    n_positions: int = 64,
+    *,
+    stiffness: str = "potential_energy",
+    edge_width: float = 0.01,
+    relief_smoothing: float = DEFAULT_RELIEF_SMOOTHING,
+    contact_smoothing: float = DEFAULT_CONTACT_SMOOTHING,
+) -> MeshCycle:
+    """Quasi-static mesh quantities over one mesh period (see ``MeshCycle``).
+
+    Args:
+        pair: the gear pair.
+        torque: gear 1 torque T1, N m (traced).
+        n_positions: M, positions per mesh cycle (static).
+        stiffness: "potential_energy" (default) or "iso" (ISO 6336 constant single stiffness).
+        edge_width: tip edge rounding as a fraction of the base pitch over which a contact's weight rises
+            from 0 to 1 at each end of the path (0 = sharp tooth corners, step changes in km).
+        relief_smoothing: corner width of the tip relief start (fraction of the relief length).
+        contact_smoothing: width of the first-touch smoothing of the load sharing, m.
+
+    Returns:
+        MeshCycle with arrays of shape [M] or [M, 2] (pair slots) as documented there.
+    """
+    if not isinstance(n_positions, int) or n_positions < 4:
+        raise ValueError(
+            f"n_positions = {n_positions!r} is out of range; valid range: integer >= 4"
+        )
+    check_positive("torque", torque, "N m")
+    check_range("edge_width", edge_width, 0.0, 0.25)
+    geo = gear_geometry(pair)
+    tau = jnp.arange(n_positions) / n_positions
+    slots = jnp.arange(2)
+    s = geo.path_start + (tau[:, None] + slots[None, :]) * geo.base_pitch  # [M, 2]
+    weight = contact_weight(geo, s, edge_width * geo.base_pitch)
+    inside = (s >= geo.path_start) & (s <= geo.path_end)
+    # Evaluate stiffness and relief at a clipped position so out-of-path slots stay finite.
+    s_eval = jnp.clip(s, geo.path_start, geo.path_end)
+    k = pair_stiffness(pair, geo, s_eval, stiffness)
+    e = relief_separation(pair, geo, s_eval, relief_smoothing)
+    total = normal_load(pair, torque)
+    d, loads, km = jax.vmap(share_load, in_axes=(0, 0, 0, None, None))(
+        k, e, weight, total, contact_smoothing
+    )
+    rho1, rho2 = radii_of_curvature(geo, s_eval)
+    rho = jnp.stack([rho1, rho2], axis=-1)
+    r_red = rho1 * rho2 / (rho1 + rho2)
+    e_red = reduced_modulus(*pair.materials)
+    w_per_width = loads / pair.face_width
+    ph = _safe_sqrt(w_per_width * e_red / (2.0 * jnp.pi * r_red))
+    b = _safe_sqrt(8.0 * w_per_width * r_red / (jnp.pi * e_red))
+    return MeshCycle(
+        mesh_fraction=tau,
+        roll_angle=s[:, 0] / geo.base_radius[0],
+        contact_position=s,
+        in_contact=inside.astype(tau.dtype),
+        radius_of_curvature=rho,
+        reduced_radius=r_red,
+        pair_stiffness=k * weight,
+        mesh_stiffness=km,
+        static_te=d,
+        te_excitation=d - total / km,
+        load_share=loads / total,
+        normal_load=loads,
+        hertz_pressure=ph,
+        hertz_half_width=b,
+        torque=jnp.asarray(torque, dtype=tau.dtype),
+        total_load=total,
+    )

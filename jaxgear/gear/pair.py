@@ -29,7 +29,9 @@ def _pair(value, name: str) -> Float[Array, "2"]:
     if arr.ndim == 0:
         arr = jnp.stack([arr, arr])
     if arr.shape != (2,):
-        raise ValueError(f"{name} must be a scalar or a pair (gear 1, gear 2); got shape {arr.shape}")
+        raise ValueError(
+            f"{name} must be a scalar or a pair (gear 1, gear 2); got shape {arr.shape}"
+        )
     return arr
 
 
@@ -56,14 +58,18 @@ class TipRelief(eqx.Module):
         self.start_roll_angle = _pair(start_roll_angle, "TipRelief.start_roll_angle")
         shapes = (shape, shape) if isinstance(shape, str) else tuple(shape)
         if len(shapes) != 2:
-            raise ValueError(f"TipRelief.shape must be a string or a pair of strings; got {shape!r}")
+            raise ValueError(
+                f"TipRelief.shape must be a string or a pair of strings; got {shape!r}"
+            )
         for s in shapes:
             check_choice("TipRelief.shape", s, RELIEF_SHAPES)
         self.shape = shapes  # type: ignore[assignment]
 
     def __check_init__(self):
         check_non_negative("TipRelief.amount", self.amount, "m")
-        check_range("TipRelief.start_roll_angle", self.start_roll_angle, 0.0, math.pi / 2, unit="rad")
+        check_range(
+            "TipRelief.start_roll_angle", self.start_roll_angle, 0.0, math.pi / 2, unit="rad"
+        )
 
 
 class Bearings(eqx.Module):
@@ -189,8 +195,14 @@ class GearPair(eqx.Module):
         self.teeth = (z1, z2)
         # Check scalars before they are used in derived defaults.
         check_positive("module", module, "m")
-        check_range("pressure_angle", pressure_angle, 0.0, math.radians(45.0),
-                    low_inclusive=False, unit="rad")
+        check_range(
+            "pressure_angle",
+            pressure_angle,
+            0.0,
+            math.radians(45.0),
+            low_inclusive=False,
+            unit="rad",
+        )
         check_positive("face_width", face_width, "m")
         self.module = jnp.asarray(module, dtype=float)
         self.pressure_angle = jnp.asarray(pressure_angle, dtype=float)
