@@ -34,7 +34,9 @@ def test_paper_pair_reference_values(paper):
     assert float(reduced_radius(geo, geo.pitch_point)) == pytest.approx(12.826e-3, rel=1e-3)
 
 
-@pytest.mark.parametrize("torque, ph_ref, b_ref", [(700.0, 1.184e9, 267e-6), (1500.0, 1.733e9, 391e-6)])
+@pytest.mark.parametrize(
+    "torque, ph_ref, b_ref", [(700.0, 1.184e9, 267e-6), (1500.0, 1.733e9, 391e-6)]
+)
 def test_hertz_at_pitch_one_pair(paper, torque, ph_ref, b_ref):
     pair, geo = paper
     w = normal_load(pair, torque) / pair.face_width
@@ -80,8 +82,9 @@ def _textbook(z1, z2, m, alpha, x1=0.0, x2=0.0, ha=1.0):
 @pytest.mark.parametrize("shift", [(0.0, 0.0), (0.3, -0.1), (0.25, 0.25)])
 def test_non_unity_pair_against_textbook(shift):
     z1, z2, m, alpha = 23, 47, 4e-3, math.radians(25)
-    pair = jg.GearPair(teeth=(z1, z2), module=m, pressure_angle=alpha, face_width=0.03,
-                       profile_shift=shift)
+    pair = jg.GearPair(
+        teeth=(z1, z2), module=m, pressure_angle=alpha, face_width=0.03, profile_shift=shift
+    )
     geo = jg.gear_geometry(pair)
     ref = _textbook(z1, z2, m, alpha, *shift)
     assert float(geo.centre_distance) == pytest.approx(ref["a_w"], rel=1e-10)

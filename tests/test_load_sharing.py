@@ -98,13 +98,22 @@ def test_gradients_match_finite_differences(which):
             tr = jg.TipRelief(amount=value, start_roll_angle=tr.start_roll_angle, shape=tr.shape)
         else:
             tr = jg.TipRelief(amount=tr.amount, start_roll_angle=value, shape=tr.shape)
-        pair = jg.GearPair(teeth=base.teeth, module=base.module, pressure_angle=base.pressure_angle,
-                           face_width=base.face_width, tip_radius=base.tip_radius,
-                           root_radius=base.root_radius, centre_distance=base.centre_distance,
-                           backlash=base.backlash, bearings=base.bearings, tip_relief=tr)
+        pair = jg.GearPair(
+            teeth=base.teeth,
+            module=base.module,
+            pressure_angle=base.pressure_angle,
+            face_width=base.face_width,
+            tip_radius=base.tip_radius,
+            root_radius=base.root_radius,
+            centre_distance=base.centre_distance,
+            backlash=base.backlash,
+            bearings=base.bearings,
+            tip_relief=tr,
+        )
         mesh = jg.mesh_cycle(pair, 700.0, m)
-        return jnp.stack([mesh.load_share[idx, 0], mesh.static_te[idx] * 1e6,
-                          jnp.std(mesh.static_te) * 1e6])
+        return jnp.stack(
+            [mesh.load_share[idx, 0], mesh.static_te[idx] * 1e6, jnp.std(mesh.static_te) * 1e6]
+        )
 
     x0 = 10e-6 if which == "amount" else math.radians(20.9)
     h = 1e-8 if which == "amount" else 1e-5
