@@ -2,19 +2,15 @@
 """Rough surfaces: 1-D roughness height profiles of both gears, carried with the moving surfaces.
 
 The film thickness of paper Eq. (5) contains S1(x, t) and S2(x, t), the roughness of each surface,
-which
-moves with that surface's velocity uj (REFERENCE §1, §6). A :class:`Surfaces` holds one periodic
-height
-profile per gear, sampled on a uniform grid of spacing ``dx``, and a traced roughness ``scale`` (a
-design
-variable). Heights are evaluated by periodic cubic B-spline interpolation (C² smooth, exact at the
-samples), so S_j is differentiable in ``scale``, t, u_j and x.
+which moves with that surface's velocity uj (REFERENCE §1, §6). A :class:`Surfaces` holds one
+periodic height profile per gear, sampled on a uniform grid of spacing ``dx``, and a traced
+roughness ``scale`` (a design variable). Heights are evaluated by periodic cubic B-spline
+interpolation (C² smooth, exact at the samples), so S_j is differentiable in ``scale``, t, u_j and
+x.
 
-The paper's measured profiles are not public; :func:`gaussian_profile` synthesises Gaussian
-profiles with
-an exponential autocorrelation R(τ) = Rq² exp(−|τ|/β) by spectral filtering of white noise
-(REFERENCE §6).
-The correlation length quoted everywhere is the 10 % decay length ℓ = β ln 10.
+The paper's measured profiles are not public; :func:`gaussian_profile` synthesises Gaussian profiles
+with an exponential autocorrelation R(τ) = Rq² exp(−|τ|/β) by spectral filtering of white noise
+(REFERENCE §6). The correlation length quoted everywhere is the 10 % decay length ℓ = β ln 10.
 """
 
 from __future__ import annotations
@@ -175,11 +171,10 @@ def gaussian_profile(
     """Synthetic Gaussian roughness profile with exponential autocorrelation (REFERENCE §6).
 
     White noise (``jax.random.normal(key, (n,))``) is filtered in Fourier space by the square root
-    of the
-    discrete spectrum of R(τ) = exp(−|τ|/β), β = ℓ / ln 10 (so R(ℓ) = 0.1). The mean is removed and
-    the
-    profile is rescaled so that its sample Rq equals ``rq`` exactly; the autocorrelation shape is a
-    statistical property of the ensemble (the expected periodic autocorrelation is exactly R).
+    of the discrete spectrum of R(τ) = exp(−|τ|/β), β = ℓ / ln 10 (so R(ℓ) = 0.1). The mean is
+    removed and the profile is rescaled so that its sample Rq equals ``rq`` exactly; the
+    autocorrelation shape is a statistical property of the ensemble (the expected periodic
+    autocorrelation is exactly R).
 
     Args:
         key: ``jax.random`` key (reproducible: the same key gives the same profile).
@@ -247,11 +242,9 @@ def load_profile(path: str | os.PathLike, dx: float = DEFAULT_SPACING) -> np.nda
     """Read a measured profile and resample it onto a uniform grid of spacing ``dx`` (m).
 
     The file holds two whitespace- or comma-separated columns: position (m), height (m); lines
-    starting
-    with ``#`` are comments. Positions must be strictly increasing. The profile is linearly
+    starting with ``#`` are comments. Positions must be strictly increasing. The profile is linearly
     interpolated onto x0, x0 + dx, … (as many samples as fit in the measured span) and its mean
-    removed.
-    The result is used as one period of a periodic profile.
+    removed. The result is used as one period of a periodic profile.
 
     Returns:
         Heights, m, shape (n,) (NumPy array).

@@ -3,28 +3,25 @@
 
 All temperatures here are **rises above the inlet (bulk) temperature**, K; the caller adds the inlet
 temperature. Positions x are in the frame moving with the contact (the EHL grid), m; heat fluxes
-W/m²;
-velocities m/s (surface j moves along +x at u_j > 0); film thickness m.
+W/m²; velocities m/s (surface j moves along +x at u_j > 0); film thickness m.
 
 Contents:
 
-* Steady surface temperature of a half-space moving under a heat source, high-Péclet (Jaeger) form
-of
-  paper Eq. (9): :func:`surface_temperature_rise`, :func:`moving_source_matrices`,
+* Steady surface temperature of a half-space moving under a heat source, high-Péclet (Jaeger)
+  form of paper Eq. (9): :func:`surface_temperature_rise`, :func:`moving_source_matrices`,
   :func:`steady_surface_operator`.
 * Transient form with memory of the flux history (1-D conduction into the depth of each material
-point
-  carried through the contact): :class:`SubsurfaceTemperature`, :func:`depth_grid`,
+  point carried through the contact): :class:`SubsurfaceTemperature`, :func:`depth_grid`,
   :func:`transient_init`, :func:`transient_predict`, :func:`transient_update`,
   :func:`transient_step`.
 * Film: parabolic temperature profile across the film, conducted fluxes, heat partition ϑ (paper
-Eqs.
-  10-11), mean film temperature with and without convection: :func:`film_temperature_profile`,
-  :func:`conducted_fluxes`, :func:`surface_temperature_difference`,
-  :func:`partition_from_temperatures`,
-  :func:`mean_film_temperature`, :func:`mean_film_temperature_convective`, :func:`partition_fluxes`.
-* :func:`solve_contact_temperatures`: the consistent set (both surface temperatures, partition, mean
-  film temperature) for a given heat source Q(x) and film h(x).
+  Eqs. 10-11), mean film temperature with and without convection:
+  :func:`film_temperature_profile`, :func:`conducted_fluxes`,
+  :func:`surface_temperature_difference`, :func:`partition_from_temperatures`,
+  :func:`mean_film_temperature`, :func:`mean_film_temperature_convective`,
+  :func:`partition_fluxes`.
+* :func:`solve_contact_temperatures`: the consistent set (both surface temperatures, partition,
+  mean film temperature) for a given heat source Q(x) and film h(x).
 """
 
 from __future__ import annotations
@@ -39,7 +36,8 @@ from .._validation import check_non_negative, check_positive
 from ..material import Material
 
 # 1 pm floor on h in the partition system: far below any film (kf·A ≈ 1e-9 m on µm grids), it only
-# settles the otherwise indeterminate partition at nodes with no upstream flux in either solid (ϑ = ½).
+# settles the otherwise indeterminate partition at nodes with no upstream flux in either solid
+# (ϑ = ½ there).
 _FILM_FLOOR = 1e-12
 _TINY_VELOCITY = 1e-12  # m/s; keeps 1/√|u| finite at u = 0 (the high-Péclet form is invalid there)
 
@@ -61,8 +59,7 @@ def _thermal_inertia(solid: Material):
 
 
 def _upstream_left_matrix(x: Float[Array, " n"]) -> Float[Array, "n n"]:
-    """K with (K q)_i = ∫_{x' < x_i} q(x') (x_i − x')^(−½) dx' for q piecewise linear between
-    nodes."""
+    """K with (K q)_i = ∫_{x' < x_i} q(x') (x_i − x')^(−½) dx', q linear between nodes."""
     n = x.shape[0]
     seg = jnp.diff(x)  # (n-1,)
     s_far = x[:, None] - x[None, :-1]  # x_i − x_j        (segment's upstream end)
@@ -80,17 +77,14 @@ def _upstream_left_matrix(x: Float[Array, " n"]) -> Float[Array, "n n"]:
 
 
 def moving_source_matrices(x: Float[Array, " n"]) -> Float[Array, "2 n n"]:
-    """Influence matrices of the steady high-Péclet moving heat source on the grid ``x`` (REFERENCE
-    §5).
+    """Influence matrices of the steady high-Péclet moving heat source on ``x`` (REFERENCE §5).
 
     ``K[0] @ q`` = ∫_{x' < x} q(x') (x − x')^(−½) dx' (surface moving towards +x: upstream on the
-    left),
-    ``K[1] @ q`` = ∫_{x' > x} q(x') (x' − x)^(−½) dx' (surface moving towards −x), both exact for a
-    flux
-    interpolated linearly between the nodal values q (cell integrals of the kernel done
-    analytically).
-    ``x`` must be strictly increasing (uniform or not). Units: m^½. Build once per grid and pass to
-    :func:`surface_temperature_rise` / :func:`steady_surface_operator` to avoid the O(n²) rebuild.
+    left), ``K[1] @ q`` = ∫_{x' > x} q(x') (x' − x)^(−½) dx' (surface moving towards −x), both exact
+    for a flux interpolated linearly between the nodal values q (cell integrals of the kernel done
+    analytically). ``x`` must be strictly increasing (uniform or not). Units: m^½. Build once per
+    grid and pass to :func:`surface_temperature_rise` / :func:`steady_surface_operator` to avoid the
+    O(n²) rebuild.
     """
     x = jnp.asarray(x)
     forward = _upstream_left_matrix(x)
@@ -124,8 +118,7 @@ def surface_temperature_rise(
     Δϕ(x) = (1/√(π ρ c k |u|)) ∫_upstream^x q(x') |x − x'|^(−½) dx',
 
     the upstream side following the sign of ``velocity`` (u > 0: material arrives from smaller x).
-    Valid
-    at high Péclet number |u| a/κ ≫ 1 (a: source half-width); no conduction along x.
+    Valid at high Péclet number |u| a/κ ≫ 1 (a: source half-width); no conduction along x.
 
     Args:
         x: node positions, m, shape (n,), strictly increasing (uniform or not).
@@ -151,17 +144,20 @@ class SubsurfaceTemperature(eqx.Module):
     Model (high Péclet, conduction only into the depth z, each material point carried through the
     contact at the surface velocity u(t)):
 
-        ρ c (∂T/∂t + u ∂T/∂x) = k ∂²T/∂z²,   −k ∂T/∂z|_{z=0} = q(x, t),   T → 0 at depth and at
-        inlet.
+        ρ c (∂T/∂t + u ∂T/∂x) = k ∂²T/∂z²,   −k ∂T/∂z|_{z=0} = q(x, t),
+        T → 0 at depth and in material entering the grid.
 
     Its Green's function gives the surface temperature of a material point as
-    Δϕ = (1/√(π ρ c k)) ∫ q(along its path, t') (t − t')^(−½) dt' (paper Eq. 9 with the memory of
-    the
-    flux history; for constant u and steady q it equals :func:`surface_temperature_rise`).
+
+        Δϕ = (1/√(π ρ c k)) ∫ q(along its path, t') (t − t')^(−½) dt'
+
+    (paper Eq. 9 with the memory of the flux history; for constant u and steady q it equals
+    :func:`surface_temperature_rise`). Discretisation: semi-Lagrangian advection (linear
+    interpolation; exact shift when |u| dt/dx = 1) and backward-Euler finite volumes on a
+    geometric depth grid; the step is unconditionally stable.
 
     Attributes:
-        temperature: T(x_i, z_k), rise above bulk, K, shape (n, nz) on the contact grid × depth
-        grid.
+        temperature: T(x_i, z_k), rise above bulk, K, shape (n, nz) (contact grid × depth grid).
         depth: z_k, m, shape (nz,), z_0 = 0 (the surface), increasing (see :func:`depth_grid`).
     """
 
@@ -214,8 +210,7 @@ def transient_init(n: int, depth=None) -> SubsurfaceTemperature:
 
 
 def _advect(temperature, shift_cells):
-    """T(x_i − shift·dx) by linear interpolation; material arriving from outside the grid is at
-    0."""
+    """T(x_i − shift·dx), linear interpolation; material entering from outside the grid is at 0."""
     n = temperature.shape[0]
     zero = jnp.zeros((1, temperature.shape[1]), temperature.dtype)
     padded = jnp.concatenate([zero, temperature, zero], axis=0)  # row r ↔ node r − 1
@@ -248,9 +243,8 @@ def transient_predict(
     """First half of one implicit time step, independent of the new heat flux.
 
     The step is linear in the new flux q: T_new(x, z) = free(x, z) + q(x) · unit(z). So the new
-    surface
-    temperature is ``free[:, 0] + unit[0] * q`` — a diagonal response the EHL fixed point can use
-    without re-solving (see :func:`solve_contact_temperatures` ``surface_response``).
+    surface temperature is ``free[:, 0] + unit[0] * q`` — a diagonal response the EHL fixed point
+    can use without re-solving (see :func:`solve_contact_temperatures` ``surface_response``).
 
     Args:
         state: subsurface temperature at the previous time.
@@ -394,9 +388,8 @@ def mean_film_temperature_convective(
 
         (12 kf/h)(ϕm − (ϕ1+ϕ2)/2) = Q − ρ cf h [ur ∂x ϕm + (us/12) ∂x(ϕ1 − ϕ2) + ∂t ϕm],
 
-    the left side being Q1 + Q2 of :func:`conducted_fluxes`. Multiplied by h (so h → 0 gives
-    ϕm → (ϕ1+ϕ2)/2 without division) and solved by implicit first-order upwind marching from the
-    inlet
+    the left side being Q1 + Q2 of :func:`conducted_fluxes`. Multiplied by h (so h → 0 gives ϕm →
+    (ϕ1+ϕ2)/2 without division) and solved by implicit first-order upwind marching from the inlet
     (the side ur comes from), as a linear recurrence ϕm_i = α_i ϕm_{i−1} + β_i evaluated with
     ``lax.associative_scan``. ∂x(ϕ1 − ϕ2) by central differences; ∂t ϕm by backward Euler when
     ``dt`` (s) and ``previous`` (ϕm at t − dt) are given, otherwise quasi-steady.
@@ -453,12 +446,9 @@ def partition_fluxes(
     """Conducted fluxes (Q1, Q2), W/m², consistent with the film and both solids' surface responses.
 
     Solids: ϕ_j = offset_j + A_j Q_j (A_j an (n, n) matrix such as :func:`steady_surface_operator`,
-    or
-    an (n,) diagonal such as the transient ``unit[0]``). Film (REFERENCE §5, no convection in Q,
-    which
-    the caller may pass as Q − C): Q1 = Q/2 − (kf/h)(ϕ1 − ϕ2), Q2 = Q − Q1 (equivalent to paper Eq.
-    11).
-    Eliminating gives the linear system
+    or an (n,) diagonal such as the transient ``unit[0]``). Film (REFERENCE §5, no convection in Q,
+    which the caller may pass as Q − C): Q1 = Q/2 − (kf/h)(ϕ1 − ϕ2), Q2 = Q − Q1 (equivalent to
+    paper Eq. 11). Eliminating gives the linear system
 
         [h I + kf (A1 + A2)] Q1 = h Q/2 + kf (A2 Q + offset2 − offset1),
 
@@ -532,15 +522,13 @@ def solve_contact_temperatures(
 
     Unknowns Q1, Q2 (conducted into the solids), ϕ1, ϕ2, ϕm. Equations: each solid's surface
     temperature from its conducted flux (steady Jaeger operator of :func:`steady_surface_operator`,
-    or
-    the transient diagonal response of :func:`transient_predict` via ``surface_response``); the
-    film's
-    parabolic-profile fluxes (:func:`conducted_fluxes`); the film-averaged energy equation. With
-    C = ρ cf h [ur ∂x ϕm + (us/12) ∂x(ϕ1 − ϕ2) + ∂t ϕm], the system is linear: for given C,
+    or the transient diagonal response of :func:`transient_predict` via ``surface_response``); the
+    film's parabolic-profile fluxes (:func:`conducted_fluxes`); the film-averaged energy equation.
+    With C = ρ cf h [ur ∂x ϕm + (us/12) ∂x(ϕ1 − ϕ2) + ∂t ϕm], the system is linear: for given C,
     :func:`partition_fluxes` with Q − C gives Q1, Q2 exactly; ϕm then follows by upwind marching
     (:func:`mean_film_temperature_convective`) and C is updated — a fixed point iterated
-    ``n_iterations`` times (``lax.fori_loop``, reverse-differentiable). C/Q is small (≈ 1e-3 at
-    h ≈ 0.1-1 µm), so a few iterations converge to round-off; ``residual`` reports the last change.
+    ``n_iterations`` times (``lax.fori_loop``, reverse-differentiable). C/Q is small (≈ 1e-3 at h ≈
+    0.1-1 µm), so a few iterations converge to round-off; ``residual`` reports the last change.
     Without convection (``convection=False``) C = 0 and one linear solve is exact.
 
     Args:
