@@ -172,7 +172,7 @@ def test_file_round_trip_with_resampling(tmp_path):
     assert grid[-1] <= x[-1] + 1e-15 and grid[-1] + dx > x[-1]
     expect = wave(grid)
     expect = expect - expect.mean()
-    # linear interpolation of data sampled every ≤ 0.4 µm: error ≤ (0.4 µm)²/8 · max|z"| ≈ 1.4e-10
+    # linear interpolation of data sampled every ≤ 0.4 µm: error ≤ (0.4 µm)²/8 · max|z"| ≈ 1.9e-10
     np.testing.assert_allclose(loaded, expect, atol=2e-10)
     assert abs(loaded.mean()) < 1e-20
     # exact round trip of a profile already on the grid (comma-separated this time)
