@@ -21,3 +21,8 @@ from .gear.pair import TipRelief as TipRelief
 from .material import Material as Material
 
 __version__ = "0.1.0"
+from .lubrication import thermal as thermal
+from .lubrication.friction_models import ConstantFriction as ConstantFriction
+from .lubrication.friction_models import FrictionModel as FrictionModel
+from .lubrication.friction_models import XuFriction as XuFriction
+from .lubrication.roughness import Surfaces as Surfaces
