@@ -377,3 +377,30 @@ def test_bad_inputs_raise():
         th.depth_grid(10, 1e-6, 5e-6)
     with pytest.raises(ValueError, match="n_depth"):
         th.depth_grid(2)
+
+
+@pytest.mark.parametrize(("u1", "u2"), [(-4.5, -3.5), (3.0, -2.0)])
+def test_partition_for_negative_and_opposite_velocities(u1, u2):
+    # Both towards −x: the mirror image of the +x problem. Opposite directions (general dense
+    # branch): the defining relations still hold.
+    x, flux, _, _ = _hertzian_source(n=129, u1=abs(u1), u2=abs(u2))
+    flux = flux * (1 + 0.3 * x / float(x[-1]))  # asymmetric source
+    h = 0.3e-6
+    res = th.solve_contact_temperatures(x, flux, h, u1, u2, STEEL, STEEL, convection=False, **OIL)
+    np.testing.assert_allclose(
+        np.asarray(res.flux1 + res.flux2), np.asarray(flux), atol=1e-9 * float(flux.max())
+    )
+    for surf, q, u in ((res.surface1, res.flux1, u1), (res.surface2, res.flux2, u2)):
+        np.testing.assert_allclose(
+            np.asarray(surf),
+            np.asarray(th.surface_temperature_rise(x, q, u, STEEL)),
+            rtol=1e-9,
+            atol=1e-9,
+        )
+    if u1 < 0 and u2 < 0:
+        mirror = th.solve_contact_temperatures(
+            -x[::-1], flux[::-1], h, -u1, -u2, STEEL, STEEL, convection=False, **OIL
+        )
+        np.testing.assert_allclose(
+            np.asarray(res.surface1), np.asarray(mirror.surface1[::-1]), rtol=1e-10, atol=1e-10
+        )

@@ -132,7 +132,11 @@ def surface_temperature_rise(
     Returns:
         Δϕ at the nodes, K, shape (n,).
     """
-    return steady_surface_operator(x, velocity, solid, matrices) @ jnp.asarray(heat_flux)
+    k = moving_source_matrices(x) if matrices is None else matrices
+    q = jnp.asarray(heat_flux)
+    integral = jnp.where(velocity >= 0.0, k[0] @ q, k[1] @ q)  # two mat-vecs, no matrix copy
+    speed = jnp.maximum(jnp.abs(velocity), _TINY_VELOCITY)
+    return integral / (jnp.sqrt(jnp.pi * speed) * _thermal_inertia(solid))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -615,16 +619,38 @@ def _solve_contact_temperatures(
     hp = jnp.maximum(h, _FILM_FLOOR)  # partition system only (see _FILM_FLOOR)
     rho_c = film_density * film_specific_heat
 
-    # The linear system's matrix is the same for every C: factor it once.
     dense = jnp.ndim(op1) == 2 or jnp.ndim(op2) == 2
     if dense:
         a1 = op1 if jnp.ndim(op1) == 2 else jnp.diag(jnp.broadcast_to(op1, (n,)))
         a2 = op2 if jnp.ndim(op2) == 2 else jnp.diag(jnp.broadcast_to(op2, (n,)))
-        lu = jax.scipy.linalg.lu_factor(jnp.diag(hp) + kf[:, None] * (a1 + a2))
+        system = jnp.diag(hp) + kf[:, None] * (a1 + a2)
+        if surface_response is None:
+            # Jaeger operators are triangular (lower when the solids move towards +x, upper towards
+            # −x): an O(n²) triangular solve, no factorisation. Opposite directions: dense solve.
+            branch = jnp.where(
+                (u1 >= 0.0) & (u2 >= 0.0), 0, jnp.where((u1 < 0.0) & (u2 < 0.0), 1, 2)
+            )
+
+            def solve(rhs):
+                return jax.lax.switch(
+                    branch,
+                    [
+                        lambda r: jax.scipy.linalg.solve_triangular(system, r, lower=True),
+                        lambda r: jax.scipy.linalg.solve_triangular(system, r, lower=False),
+                        lambda r: jnp.linalg.solve(system, r),
+                    ],
+                    rhs,
+                )
+        else:
+            # A general operator: factor once, reuse for every C.
+            lu = jax.scipy.linalg.lu_factor(system)
+
+            def solve(rhs):
+                return jax.scipy.linalg.lu_solve(lu, rhs)
 
         def fluxes(q_eff):
             rhs = 0.5 * hp * q_eff + kf * (a2 @ q_eff + off2 - off1)
-            q1 = jax.scipy.linalg.lu_solve(lu, rhs)
+            q1 = solve(rhs)
             return q1, q_eff - q1, off1 + a1 @ q1, off2 + a2 @ (q_eff - q1)
     else:
 
