@@ -57,6 +57,15 @@ def main(repeats: int) -> list[tuple[str, int, float, float]]:
             ("surface_temperature_rise (builds K)", n)
             + _time(lambda x, q: th.surface_temperature_rise(x, q, 4.0, steel), (x, flux), repeats)
         )
+        dx = float(x[1] - x[0])
+        rows.append(
+            ("surface_temperature_rise_uniform (FFT)", n)
+            + _time(
+                lambda q, dx=dx: th.surface_temperature_rise_uniform(dx, q, 4.0, steel),
+                (flux,),
+                repeats,
+            )
+        )
         mats = th.moving_source_matrices(x)
         rows.append(
             ("surface_temperature_rise (given K)", n)
@@ -73,7 +82,7 @@ def main(repeats: int) -> list[tuple[str, int, float, float]]:
         rows.append(
             ("transient_step (48 depth nodes)", n)
             + _time(
-                lambda s, q: th.transient_step(s, q, dx, 4.0, dx / 2.7, steel),
+                lambda s, q, dx=dx: th.transient_step(s, q, dx, 4.0, dx / 2.7, steel),
                 (state, flux),
                 repeats,
             )
@@ -85,7 +94,7 @@ def main(repeats: int) -> list[tuple[str, int, float, float]]:
         rows.append(
             ("solve_contact_temperatures (steady, convection, 12 it.)", n)
             + _time(
-                lambda m, q, h: th.solve_contact_temperatures(
+                lambda m, q, h, x=x: th.solve_contact_temperatures(
                     x, q, h, 4.5, 3.5, steel, steel, 1004.0, 2000.0, 0.15, matrices=m
                 ),
                 (mats, flux, h),
