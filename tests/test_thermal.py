@@ -254,7 +254,7 @@ def test_convective_marching_against_exponential_closed_form(direction):
 
 def test_convection_solve_is_consistent_and_cools_the_surfaces():
     u1, u2 = 4.5, 3.5
-    x, flux, _, _ = _hertzian_source(n=257, u1=u1, u2=u2)
+    x, flux, _, _ = _hertzian_source(n=129, u1=u1, u2=u2)
     h = jnp.full_like(x, 1.0e-6)
     dry = th.solve_contact_temperatures(x, flux, h, u1, u2, STEEL, STEEL, convection=False, **OIL)
     wet = th.solve_contact_temperatures(x, flux, h, u1, u2, STEEL, STEEL, convection=True, **OIL)
@@ -410,17 +410,18 @@ def test_contact_solve_gradients_and_no_retrace():
     # d(max ϕ1)/d u1 and d(max ϕ1)/d(flux scale) through the whole solve (convection on) against
     # central differences; new values of traced inputs must not retrace the compiled solve.
     u1, u2 = 4.5, 3.5
-    x, flux, _, _ = _hertzian_source(n=257, u1=u1, u2=u2)
+    x, flux, _, _ = _hertzian_source(n=129, u1=u1, u2=u2)
     h = jnp.full_like(x, 0.5e-6)
     mats = th.moving_source_matrices(x)
 
+    @jax.jit
     def peak(v1, scale):
         res = th.solve_contact_temperatures(
             x, scale * flux, h, v1, u2, STEEL, STEEL, matrices=mats, **OIL
         )
         return jnp.max(res.surface1)
 
-    g1, gs = jax.grad(peak, argnums=(0, 1))(u1, 1.0)
+    g1, gs = jax.jit(jax.grad(peak, argnums=(0, 1)))(u1, 1.0)
     fd1 = (peak(u1 + 1e-4, 1.0) - peak(u1 - 1e-4, 1.0)) / 2e-4
     fds = (peak(u1, 1.0 + 1e-4) - peak(u1, 1.0 - 1e-4)) / 2e-4
     assert float(g1) == pytest.approx(float(fd1), rel=1e-5)
@@ -443,12 +444,13 @@ def test_transient_step_velocity_gradient():
     dx = float(x[1] - x[0])
     flux = 1e9 * jnp.exp(-((x / 1.5e-4) ** 2))
 
+    @jax.jit
     def surface_after(v):
         step = lambda s, _: (th.transient_step(s, flux, dx, v, 0.43 * dx / 3.0, STEEL)[0], None)
-        final = jax.lax.scan(step, th.transient_init(n), None, length=60)[0]
+        final = jax.lax.scan(step, th.transient_init(n), None, length=30)[0]
         return jnp.sum(final.surface)
 
-    g = jax.grad(surface_after)(3.0)
+    g = jax.jit(jax.grad(surface_after))(3.0)
     fd = (surface_after(3.0 + 1e-6) - surface_after(3.0 - 1e-6)) / 2e-6
     assert float(g) == pytest.approx(float(fd), rel=1e-5)
 
@@ -460,7 +462,7 @@ def test_uniform_fft_form_equals_matrix_form(velocity):
     x = jnp.linspace(-1e-3, 5e-4, 301)
     dx = float(x[1] - x[0])
     flux = 1e9 * jnp.exp(-((x / 4e-4) ** 2)) * (1 + x / 1e-3)
-    dense = th.surface_temperature_rise(x, flux, velocity, STEEL)
+    dense = jax.jit(th.surface_temperature_rise)(x, flux, velocity, STEEL)
     fast = jax.jit(th.surface_temperature_rise_uniform)(dx, flux, velocity, STEEL)
     np.testing.assert_allclose(
         np.asarray(fast), np.asarray(dense), rtol=0, atol=1e-12 * float(dense.max())
@@ -469,5 +471,5 @@ def test_uniform_fft_form_equals_matrix_form(velocity):
     b = 267e-6
     xb = jnp.linspace(-2 * b, 2 * b, 1025)
     band = jnp.where(jnp.abs(xb) <= b * (1 + 1e-9), 1e8, 0.0)
-    rise = th.surface_temperature_rise_uniform(float(xb[1] - xb[0]), band, 4.0, STEEL)
+    rise = jax.jit(th.surface_temperature_rise_uniform)(float(xb[1] - xb[0]), band, 4.0, STEEL)
     assert float(jnp.max(rise)) == pytest.approx(jaeger_band_max(1e8, 2 * b, 4.0), rel=0.015)

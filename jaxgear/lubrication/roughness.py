@@ -15,6 +15,7 @@ with an exponential autocorrelation R(τ) = Rq² exp(−|τ|/β) by spectral fil
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 
@@ -199,6 +200,11 @@ def gaussian_profile(
     check_non_negative("rq", rq, "m")
     if not isinstance(n, int | np.integer) or n < 4:
         raise ValueError(f"n = {n!r} is not valid; valid range: integer ≥ 4")
+    return _gaussian_profile(key, n, dx, rq, correlation_length)
+
+
+@functools.partial(jax.jit, static_argnums=1)
+def _gaussian_profile(key, n, dx, rq, correlation_length):
     noise = jax.random.normal(key, (n,), dtype=jnp.result_type(float))
     psd = exponential_psd(n, dx, correlation_length)
     z = jnp.fft.irfft(jnp.fft.rfft(noise) * jnp.sqrt(psd), n=n)

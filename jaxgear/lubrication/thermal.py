@@ -442,8 +442,8 @@ def mean_film_temperature_convective(
 
     the left side being Q1 + Q2 of :func:`conducted_fluxes`. Multiplied by h (so h → 0 gives ϕm →
     (ϕ1+ϕ2)/2 without division) and solved by implicit first-order upwind marching from the inlet
-    (the side ur comes from), as a linear recurrence ϕm_i = α_i ϕm_{i−1} + β_i evaluated with
-    ``lax.associative_scan``. ∂x(ϕ1 − ϕ2) by central differences; ∂t ϕm by backward Euler when
+    (the side ur comes from), as a linear recurrence ϕm_i = α_i ϕm_{i−1} + β_i run by
+    ``lax.scan``. ∂x(ϕ1 − ϕ2) by central differences; ∂t ϕm by backward Euler when
     ``dt`` (s) and ``previous`` (ϕm at t − dt) are given, otherwise quasi-steady.
 
     Args:
@@ -481,14 +481,14 @@ def mean_film_temperature_convective(
     # March from the inlet side: reverse the arrays when ur < 0.
     alpha_m = jnp.where(forward, alpha, alpha[::-1])
     beta_m = jnp.where(forward, beta, beta[::-1])
-    beta_m = beta_m.at[0].add(alpha_m[0] * inlet_temperature)
 
-    def compose(first, second):  # affine maps y ↦ a y + b, applied first then second
-        a1, b1 = first
-        a2, b2 = second
-        return a2 * a1, a2 * b1 + b2
+    def march(previous_node, coefficients):
+        a, b = coefficients
+        value = a * previous_node + b
+        return value, value
 
-    _, phim_m = jax.lax.associative_scan(compose, (alpha_m, beta_m))
+    # sequential lax.scan: on CPU it compiles ~10× faster and runs faster than associative_scan
+    _, phim_m = jax.lax.scan(march, jnp.asarray(inlet_temperature, beta_m.dtype), (alpha_m, beta_m))
     return jnp.where(forward, phim_m, phim_m[::-1])
 
 
