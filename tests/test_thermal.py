@@ -473,3 +473,18 @@ def test_uniform_fft_form_equals_matrix_form(velocity):
     band = jnp.where(jnp.abs(xb) <= b * (1 + 1e-9), 1e8, 0.0)
     rise = jax.jit(th.surface_temperature_rise_uniform)(float(xb[1] - xb[0]), band, 4.0, STEEL)
     assert float(jnp.max(rise)) == pytest.approx(jaeger_band_max(1e8, 2 * b, 4.0), rel=0.015)
+
+
+def test_contact_solve_vmap_equals_loop():
+    x, flux, _, _ = _hertzian_source(n=65)
+    f = lambda u: th.solve_contact_temperatures(x, flux, 0.3e-6, u, 3.5, STEEL, STEEL, **OIL)
+    speeds = jnp.array([3.0, 4.0, 5.0])
+    batched = jax.vmap(f)(speeds)
+    for i, u in enumerate(speeds):
+        one = f(u)
+        np.testing.assert_allclose(
+            np.asarray(batched.surface1[i]), np.asarray(one.surface1), rtol=1e-12
+        )
+        np.testing.assert_allclose(
+            np.asarray(batched.film_mean[i]), np.asarray(one.film_mean), rtol=1e-12
+        )
