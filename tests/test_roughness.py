@@ -106,6 +106,13 @@ def test_moving_profile_is_carried_with_the_surface():
             rtol=0,
             atol=1e-9 * 0.4e-6,
         )
+    # time-varying velocity: the displacement form with d = ∫u dt equals the constant-u form
+    np.testing.assert_allclose(
+        np.asarray(s.displaced_height(0, x, 3.1 * 2.3e-5)),
+        np.asarray(s.height(0, x, 2.3e-5, 3.1)),
+        rtol=0,
+        atol=1e-12 * 0.4e-6,
+    )
     # a whole number m of samples travelled: heights at the samples are the rolled profile
     m = 37
     u = 2.0

@@ -15,6 +15,7 @@ with an exponential autocorrelation R(τ) = Rq² exp(−|τ|/β) by spectral fil
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 
@@ -87,7 +88,7 @@ class Surfaces(eqx.Module):
         """Roughness of surface ``index`` (0: gear 1, 1: gear 2) at contact-frame positions ``x``.
 
         S_j(x, t) = scale · z_j(x − x_j0 − u_j t): the profile is carried with the surface moving at
-        ``velocity`` u_j (m/s) along +x. Periodic cubic B-spline interpolation of the samples.
+        the constant ``velocity`` u_j (m/s) along +x. Periodic cubic B-spline interpolation.
 
         Args:
             index: 0 or 1 (static).
@@ -98,10 +99,18 @@ class Surfaces(eqx.Module):
         Returns:
             Heights, m, shape of ``x``.
         """
+        return self.displaced_height(index, x, velocity * t)
+
+    def displaced_height(self, index: int, x, displacement) -> Float[Array, ...]:
+        """S_j = scale · z_j(x − x_j0 − d_j) for a surface displaced by d_j = ∫ u_j dt (m).
+
+        Use this form when u_j varies in time (a gear mesh): carry d_j in the time-stepping state.
+        Shapes and units as :meth:`height`.
+        """
         if index not in (0, 1):
             raise ValueError(f"index = {index!r} is not valid; valid choices: 0, 1")
         z = self.profile1 if index == 0 else self.profile2
-        xi = jnp.asarray(x) - self.offset[index] - velocity * t
+        xi = jnp.asarray(x) - self.offset[index] - displacement
         return self.scale * periodic_cubic_interpolate(z, self.dx, xi)
 
     def heights(self, x, t, u1, u2) -> tuple[Float[Array, ...], Float[Array, ...]]:
@@ -191,6 +200,11 @@ def gaussian_profile(
     check_non_negative("rq", rq, "m")
     if not isinstance(n, int | np.integer) or n < 4:
         raise ValueError(f"n = {n!r} is not valid; valid range: integer ≥ 4")
+    return _gaussian_profile(key, n, dx, rq, correlation_length)
+
+
+@functools.partial(jax.jit, static_argnums=1)
+def _gaussian_profile(key, n, dx, rq, correlation_length):
     noise = jax.random.normal(key, (n,), dtype=jnp.result_type(float))
     psd = exponential_psd(n, dx, correlation_length)
     z = jnp.fft.irfft(jnp.fft.rfft(noise) * jnp.sqrt(psd), n=n)
