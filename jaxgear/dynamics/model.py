@@ -109,19 +109,25 @@ class DynamicsOptions(eqx.Module):
         steps_per_period: fixed steps of the Runge-Kutta solver per mesh period. Static. The default 128
             Tsit5 steps keep the DTE RMS within 1e-6 relative of a 4× finer solve over 500-4200 rpm
             (benchmarks/dynamics.py prints the check).
-        newton_max_steps: Newton iterations on the periodicity condition. Static.
+        newton_max_steps: Newton iterations on the periodicity condition for one speed. Static.
+        newton_batch_steps: iterations for a whole batch of speeds together; members not converged
+            by then are redone one at a time (transient decay, then ``newton_max_steps``). Static.
         newton_tol: convergence tolerance on the scaled periodicity residual (dimensionless, relative to
             the state's magnitude).
         solver: a diffrax Runge-Kutta solver (static structure), default Tsit5.
+        transient_periods: mesh periods integrated to let transients decay before a second Newton
+            attempt when the first fails or finds an unstable orbit. Static.
         n_positions: positions M of the mesh cycle built when none is passed. Static.
     """
 
     backlash: str = eqx.field(static=True, default="exact")
     backlash_width: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1e-7)
     steps_per_period: int = eqx.field(static=True, default=128)
-    newton_max_steps: int = eqx.field(static=True, default=24)
+    newton_max_steps: int = eqx.field(static=True, default=30)
+    newton_batch_steps: int = eqx.field(static=True, default=8)
     newton_tol: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1e-9)
     solver: object = eqx.field(static=True, default=None)
+    transient_periods: int = eqx.field(static=True, default=60)
     n_positions: int = eqx.field(static=True, default=64)
 
     def __check_init__(self):

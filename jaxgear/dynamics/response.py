@@ -35,6 +35,10 @@ N_HARMONICS = 10
 STATUS_CONVERGED = 0
 STATUS_NOT_CONVERGED = 1
 STATUS_NOT_FINITE = 2
+STATUS_UNSTABLE = 3
+
+#: Floquet multipliers up to 1 + this count as stable (the free rigid rotation has exactly 1).
+STABILITY_TOL = 1e-6
 
 
 class DynamicResponse(eqx.Module):
@@ -53,7 +57,10 @@ class DynamicResponse(eqx.Module):
         contact_lost: any contact loss over the cycle.
         dte_harmonics: amplitudes εd,q of mesh harmonics q = 1..10, m [10].
         dte_rms: √(Σq εd,q²), m (REFERENCE §7 R1).
-        converged, status (0 converged, 1 Newton did not converge, 2 not finite), newton_iterations,
+        converged: Newton met ``newton_tol``; stable: all Floquet multipliers |μ| ≤ 1 + 1e-6 (an
+        unstable periodic orbit is a solution that the real gears would leave);
+        floquet_multiplier: the largest |μ|; status: 0 converged and stable, 1 Newton did not
+        converge, 2 not finite, 3 converged to an unstable orbit; newton_iterations,
         periodicity_residual: max |z(Tm) − z(0)| / max |z| of the returned orbit (dimensionless).
         initial_state: the shooting unknowns [13] (scaled state at τ = 0 and s), reusable as a guess.
     """
@@ -75,6 +82,8 @@ class DynamicResponse(eqx.Module):
     dte_harmonics: Float[Array, " 10"]
     dte_rms: Float[Array, ""]
     converged: Bool[Array, ""]
+    stable: Bool[Array, ""]
+    floquet_multiplier: Float[Array, ""]
     status: Int[Array, ""]
     newton_iterations: Int[Array, ""]
     periodicity_residual: Float[Array, ""]
@@ -105,13 +114,11 @@ def _integrate(dyn: GearDynamics, z0, s, options: DynamicsOptions, ts=None):
     return sol.ys[-1] if ts is None else sol.ys
 
 
-def _residual(dyn: GearDynamics, options: DynamicsOptions):
-    def residual(w):
-        z0, s = w[:12], w[12]
-        z1 = _integrate(dyn, z0, s, options)
-        return jnp.concatenate([z1 - z0, (z0[0] + z0[3])[None]])
-
-    return residual
+def _residual(dyn: GearDynamics, w, options: DynamicsOptions):
+    """R(w) = [z(Tm) − z0, r1φ1(0) + r2φ2(0)] (scaled), w = [z0, s]."""
+    z0, s = w[:12], w[12]
+    z1 = _integrate(dyn, z0, s, options)
+    return jnp.concatenate([z1 - z0, (z0[0] + z0[3])[None]])
 
 
 def static_guess(dyn: GearDynamics) -> Float[Array, " 13"]:
@@ -126,46 +133,174 @@ def static_guess(dyn: GearDynamics) -> Float[Array, " 13"]:
     return jnp.concatenate([q, jnp.zeros(6), jnp.zeros(1)])
 
 
-def _newton(residual, w0, options: DynamicsOptions):
-    """Newton on R(w) = 0 inside ``lax.while_loop``; returns (w, (iterations, residual norm, ok))."""
-
-    def value_and_jac(w):
-        r = residual(w)
-        return r, r
-
-    jac_fn = jax.jacfwd(value_and_jac, has_aux=True)
-
-    def scale(w):
-        return 1.0 + jnp.max(jnp.abs(w[:12]))
-
-    def cond(carry):
-        _, rnorm, i, done = carry
-        return (~done) & (i < options.newton_max_steps) & ~jnp.isnan(rnorm)
-
-    def body(carry):
-        w, _, i, _ = carry
-        jac, r = jac_fn(w)
-        rnorm = jnp.max(jnp.abs(r)) / scale(w)
-        done = rnorm <= options.newton_tol
-        step = jnp.linalg.solve(jac, -r)
-        w_new = jnp.where(done, w, w + step)
-        return w_new, rnorm, i + 1, done
-
-    init = (w0, jnp.asarray(jnp.inf, w0.dtype), jnp.asarray(0), jnp.asarray(False))
-    w, rnorm, iters, done = jax.lax.while_loop(cond, body, init)
-    return w, (iters, rnorm, done & jnp.isfinite(rnorm))
+def _scaled_norm(r, w):
+    return jnp.max(jnp.abs(r), axis=-1) / (1.0 + jnp.max(jnp.abs(w[..., :12]), axis=-1))
 
 
-def _shoot(dyn: GearDynamics, guess, options: DynamicsOptions):
-    residual = _residual(dyn, options)
+def _batch_solve_newton(dyns, w0, options: DynamicsOptions, max_steps: int):
+    """Periodic orbits of a batch of systems (leading axis B of ``dyns`` and ``w0`` [B, 13]).
 
-    def solve(f, w0):
-        return _newton(f, w0, options)
+    Newton-Broyden with lazy backtracking: the exact Jacobian (``jacfwd`` through one period, 14
+    tangent lanes) is computed at the start, refreshed for the whole batch only when some member
+    stalls (two rejected trial points in a row), and updated by Broyden's rank-one rule otherwise, so
+    most iterations cost one plain period. Linear cases converge in one exact Newton step.
+    A trial point whose residual does not fall below the last accepted one is rejected and the step
+    halved. The loop is batch-aware (scalar predicates), so it is not recomputed per member under vmap.
 
-    def tangent_solve(g, y):
-        return jnp.linalg.solve(jax.jacfwd(g)(y), y)
+    Returns (w [B, 13], (iterations [B], scaled residual [B], converged [B], max |Floquet| [B])).
+    """
+    res = jax.vmap(lambda d, w: _residual(d, w, options))
+    jac = jax.vmap(jax.jacfwd(lambda d, w: _residual(d, w, options), argnums=1))
+    n = w0.shape[-1]
+    eye = jnp.eye(n)
+    tol = options.newton_tol
+    r0 = res(dyns, w0)
+    rn0 = jnp.where(jnp.all(jnp.isfinite(r0), -1), _scaled_norm(r0, w0), jnp.inf)
+    j0 = jac(dyns, w0)
+    bsz = w0.shape[0]
 
-    return jax.lax.custom_root(residual, guess, solve, tangent_solve, has_aux=True)
+    def cond(c):
+        i, active = c[-2], c[-1]
+        return jnp.any(active) & (i < max_steps)
+
+    def body(c):
+        w, r, rn, jm, lam, fails, iters, i, active = c
+        jm_safe = jnp.where(jnp.all(jnp.isfinite(jm), (-2, -1))[:, None, None], jm, eye)
+        step = jnp.linalg.solve(jm_safe, -r[..., None])[..., 0]
+        w_try = w + lam[:, None] * step
+        r_try = res(dyns, w_try)
+        finite = jnp.all(jnp.isfinite(r_try), -1)
+        rn_try = jnp.where(finite, _scaled_norm(r_try, w_try), jnp.inf)
+        accept = active & (rn_try < rn)
+        # Broyden's (good) rank-one update on accepted members.
+        dw = w_try - w
+        dr = r_try - r
+        denom = jnp.sum(dw * dw, -1)
+        upd = (
+            jnp.einsum("bi,bj->bij", dr - jnp.einsum("bij,bj->bi", jm, dw), dw)
+            / jnp.where(denom > 0, denom, 1.0)[:, None, None]
+        )
+        jm = jnp.where(accept[:, None, None] & (denom > 0)[:, None, None], jm + upd, jm)
+        w = jnp.where(accept[:, None], w_try, w)
+        r = jnp.where(accept[:, None], r_try, r)
+        rn = jnp.where(accept, rn_try, rn)
+        iters = iters + active.astype(iters.dtype)
+        lam = jnp.where(accept, 1.0, jnp.where(active, 0.5 * lam, lam))
+        fails = jnp.where(accept, 0, fails + active.astype(fails.dtype))
+        done = rn <= tol
+        stuck = lam < 1e-4
+        active = active & ~done & ~stuck
+        # Refresh the exact Jacobian (whole batch, scalar predicate) when a member stalls.
+        refresh = jnp.any(active & (fails >= 2))
+        jm = jax.lax.cond(refresh, lambda: jac(dyns, w), lambda: jm)
+        lam = jnp.where(refresh & active, 1.0, lam)
+        fails = jnp.where(refresh, 0, fails)
+        return w, r, rn, jm, lam, fails, iters, i + 1, active
+
+    init = (
+        w0,
+        r0,
+        rn0,
+        j0,
+        jnp.ones(bsz, w0.dtype),
+        jnp.zeros(bsz, jnp.int32),
+        jnp.ones(bsz, jnp.int32),
+        jnp.asarray(0),
+        rn0 > tol,
+    )
+    w, _, rn, _, _, _, iters, _, _ = jax.lax.while_loop(cond, body, init)
+    done = rn <= tol
+    # Monodromy matrix = ∂z(Tm)/∂z0 = J[:12, :12] + I at the orbit; the free rigid rotation gives 1.
+    mono = jac(dyns, w)[:, :12, :12] + jnp.eye(12)
+    floquet = jnp.max(jnp.abs(jnp.linalg.eigvals(mono)), axis=-1)
+    return w, (iters, rn, done, floquet)
+
+
+def _transient(dyn: GearDynamics, w, options: DynamicsOptions):
+    """Integrate ``options.transient_periods`` mesh periods from w (transients decay), re-gauged."""
+    n = options.transient_periods
+    steps = options.steps_per_period * n
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(dyn),
+        _solver(options),
+        t0=0.0,
+        t1=float(n),
+        dt0=1.0 / options.steps_per_period,
+        y0=w[:12],
+        args=w[12],
+        stepsize_controller=diffrax.ConstantStepSize(),
+        saveat=diffrax.SaveAt(t1=True),
+        max_steps=steps + 2,
+        adjoint=diffrax.ForwardMode(),
+    )
+    z = sol.ys[-1]
+    rigid = 0.5 * (z[0] + z[3])
+    z = z.at[0].add(-rigid).at[3].add(-rigid)
+    return jnp.concatenate([z, w[12:]])
+
+
+def _acceptable(aux):
+    _, _, done, floquet = aux
+    return done & (floquet <= 1.0 + STABILITY_TOL)
+
+
+def _index(tree, i):
+    return jax.tree_util.tree_map(lambda a: a[i], tree)
+
+
+def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None):
+    """Batched periodic orbits with a per-member fallback and implicit differentiation.
+
+    Members whose Newton fails or ends on an unstable orbit are redone one at a time (a loop with a
+    scalar ``lax.cond``, so it costs nothing when unused): transients are let decay from
+    ``fallback_from`` (default ``w0``) for ``options.transient_periods`` periods, then Newton again.
+    The result is then passed through ``lax.custom_root`` per member, so derivatives come from the
+    implicit function theorem on R = 0 and never from the iterations.
+    """
+    dyns_c = jax.lax.stop_gradient(dyns)
+    w, aux = _batch_solve_newton(
+        dyns_c,
+        jax.lax.stop_gradient(w0),
+        options,
+        min(options.newton_batch_steps, options.newton_max_steps),
+    )
+    start = w0 if fallback_from is None else fallback_from
+    start = jax.lax.stop_gradient(start)
+
+    def redo(i, carry):
+        w, aux = carry
+        ok = _acceptable(_index(aux, i))
+
+        def again():
+            dyn_i = _index(dyns_c, i)
+            w_t = _transient(dyn_i, start[i], options)
+            dyn_1 = jax.tree_util.tree_map(lambda a: a[None], dyn_i)
+            w1, aux1 = _batch_solve_newton(dyn_1, w_t[None], options, options.newton_max_steps)
+            # keep the new attempt only if it is better (acceptable, or at least converged)
+            better = _acceptable(_index(aux1, 0)) | (aux1[2][0] & ~aux[2][i])
+            w_new = jnp.where(better, w1[0], w[i])
+            aux_new = jax.tree_util.tree_map(
+                lambda a, b: a.at[i].set(jnp.where(better, b[0], a[i])), aux, aux1
+            )
+            return w.at[i].set(w_new), aux_new
+
+        return jax.lax.cond(ok, lambda: (w, aux), again)
+
+    w, aux = jax.lax.fori_loop(0, w.shape[0], redo, (w, aux))
+
+    def attach(dyn, w_star):
+        def identity_solve(f, x):
+            return x
+
+        def tangent_solve(g, y):
+            return jnp.linalg.solve(jax.jacfwd(g)(y), y)
+
+        return jax.lax.custom_root(
+            lambda w: _residual(dyn, w, options), w_star, identity_solve, tangent_solve
+        )
+
+    w = jax.vmap(attach)(dyns, w)
+    return w, aux
 
 
 def _safe_abs_complex(c):
@@ -184,7 +319,7 @@ def dte_harmonic_amplitudes(dte, n_harmonics: int = N_HARMONICS):
 
 
 def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) -> DynamicResponse:
-    iters, _, newton_ok = aux
+    iters, _, newton_ok, floquet = aux
     m = mesh.n_positions
     ts = jnp.arange(m + 1) / m
     zs = _integrate(dyn, w[:12], w[12], options, ts=ts)
@@ -207,8 +342,13 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
     rms = jnp.sqrt(jnp.sum(harm**2))
     finite = jnp.all(jnp.isfinite(zs)) & jnp.isfinite(rms)
     converged = newton_ok & finite
+    stable = floquet <= 1.0 + STABILITY_TOL
     status = jnp.where(
-        finite, jnp.where(converged, STATUS_CONVERGED, STATUS_NOT_CONVERGED), STATUS_NOT_FINITE
+        finite,
+        jnp.where(
+            converged, jnp.where(stable, STATUS_CONVERGED, STATUS_UNSTABLE), STATUS_NOT_CONVERGED
+        ),
+        STATUS_NOT_FINITE,
     )
     return DynamicResponse(
         speed_rpm=jnp.asarray(op.speed_rpm, float),
@@ -228,6 +368,8 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
         dte_harmonics=harm,
         dte_rms=rms,
         converged=converged,
+        stable=stable,
+        floquet_multiplier=floquet,
         status=status.astype(jnp.int32),
         newton_iterations=iters.astype(jnp.int32),
         periodicity_residual=resid,
@@ -256,10 +398,11 @@ def _mesh_and_interface(pair, op, mesh, interface, options):
 
 def _steady_state(pair, op, mesh, interface, options, guess):
     dyn = build_dynamics(pair, op, mesh, interface, options)
-    if guess is None:
-        guess = static_guess(dyn)
-    w, aux = _shoot(dyn, guess, options)
-    return _postprocess(dyn, mesh, op, w, aux, options)
+    cold = static_guess(dyn)
+    guess = cold if guess is None else jnp.where(jnp.all(jnp.isfinite(guess)), guess, cold)
+    batch = jax.tree_util.tree_map(lambda a: a[None], dyn)
+    w, aux = _batch_solve(batch, guess[None], options, fallback_from=cold[None])
+    return _postprocess(dyn, mesh, op, w[0], _index(aux, 0), options)
 
 
 @eqx.filter_jit
@@ -294,7 +437,9 @@ def dynamic_response(
     """
     options = DynamicsOptions() if options is None else options
     _check_inputs(pair, op)
-    return _dynamic_response_jit(pair, op, mesh, interface, options, initial_state)
+    # NaN marks "no guess" so that passing a guess or not shares one compiled function.
+    guess = jnp.full(13, jnp.nan) if initial_state is None else jnp.asarray(initial_state, float)
+    return _dynamic_response_jit(pair, op, mesh, interface, options, guess)
 
 
 def _at_speed(op: OperatingPoint, speed_rpm) -> OperatingPoint:
@@ -311,10 +456,17 @@ def _rescale_guess(w, old_speed, new_speed):
 def _sweep_parallel(pair, op, speeds, mesh, interface, options):
     mesh, interface = _mesh_and_interface(pair, op, mesh, interface, options)
 
-    def one(speed):
-        return _steady_state(pair, _at_speed(op, speed), mesh, interface, options, None)
+    def dyn_at(speed):
+        return build_dynamics(pair, _at_speed(op, speed), mesh, interface, options)
 
-    return jax.vmap(one)(speeds)
+    dyns = jax.vmap(dyn_at)(speeds)
+    guesses = jax.vmap(static_guess)(dyns)
+    w, aux = _batch_solve(dyns, guesses, options)
+
+    def post(speed, dyn, w, aux):
+        return _postprocess(dyn, mesh, _at_speed(op, speed), w, aux, options)
+
+    return jax.vmap(post)(speeds, dyns, w, aux)
 
 
 @eqx.filter_jit
@@ -327,10 +479,12 @@ def _sweep_continuation(pair, op, speeds, mesh, interface, options):
         dyn = build_dynamics(pair, op_n, mesh, interface, options)
         cold = static_guess(dyn)
         guess = jnp.where(have_prev, _rescale_guess(w_prev, speed_prev, speed), cold)
-        w, aux = _shoot(dyn, guess, options)
-        # If the branch followed so far has disappeared (Newton fails), restart from static equilibrium:
+        # Newton from the previous orbit; if that branch has disappeared (no convergence, or only an
+        # unstable orbit is left), the state left by the previous speed decays to the new attractor:
         # this is the jump.
-        w, aux = jax.lax.cond(aux[2], lambda: (w, aux), lambda: _shoot(dyn, cold, options))
+        batch = jax.tree_util.tree_map(lambda a: a[None], dyn)
+        w, aux = _batch_solve(batch, guess[None], options)
+        w, aux = w[0], _index(aux, 0)
         res = _postprocess(dyn, mesh, op_n, w, aux, options)
         ok = res.converged
         new_carry = (jnp.where(ok, w, w_prev), jnp.where(ok, speed, speed_prev), have_prev | ok)
