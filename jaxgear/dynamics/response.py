@@ -96,22 +96,24 @@ def _solver(options: DynamicsOptions):
 
 def _integrate(dyn: GearDynamics, z0, s, options: DynamicsOptions, ts=None):
     """One mesh period from z0; returns z(1) or z at the fractions ``ts``."""
-    n = options.steps_per_period
     saveat = diffrax.SaveAt(t1=True) if ts is None else diffrax.SaveAt(ts=ts)
     sol = diffrax.diffeqsolve(
         diffrax.ODETerm(dyn),
         _solver(options),
         t0=0.0,
         t1=1.0,
-        dt0=1.0 / n,
+        dt0=dyn.step,
         y0=z0,
         args=s,
         stepsize_controller=diffrax.ConstantStepSize(),
         saveat=saveat,
-        max_steps=n + 2,
+        max_steps=options.max_steps_per_period + 2,
         adjoint=diffrax.ForwardMode(),
+        throw=False,
     )
-    return sol.ys[-1] if ts is None else sol.ys
+    ok = sol.result == diffrax.RESULTS.successful
+    ys = jnp.where(ok, sol.ys, jnp.nan)  # too many steps needed: reported as not finite
+    return ys[-1] if ts is None else ys
 
 
 def _residual(dyn: GearDynamics, w, options: DynamicsOptions):
@@ -219,21 +221,21 @@ def _batch_solve_newton(dyns, w0, options: DynamicsOptions, max_steps: int):
 def _transient(dyn: GearDynamics, w, options: DynamicsOptions):
     """Integrate ``options.transient_periods`` mesh periods from w (transients decay), re-gauged."""
     n = options.transient_periods
-    steps = options.steps_per_period * n
     sol = diffrax.diffeqsolve(
         diffrax.ODETerm(dyn),
         _solver(options),
         t0=0.0,
         t1=float(n),
-        dt0=1.0 / options.steps_per_period,
+        dt0=dyn.step,
         y0=w[:12],
         args=w[12],
         stepsize_controller=diffrax.ConstantStepSize(),
         saveat=diffrax.SaveAt(t1=True),
-        max_steps=steps + 2,
+        max_steps=(options.max_steps_per_period + 2) * n,
         adjoint=diffrax.ForwardMode(),
+        throw=False,
     )
-    z = sol.ys[-1]
+    z = jnp.where(sol.result == diffrax.RESULTS.successful, sol.ys[-1], jnp.nan)
     rigid = 0.5 * (z[0] + z[3])
     z = z.at[0].add(-rigid).at[3].add(-rigid)
     return jnp.concatenate([z, w[12:]])
