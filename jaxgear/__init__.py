@@ -30,3 +30,8 @@ from .dynamics import dynamic_response_sweep as dynamic_response_sweep
 from .dynamics import mode_shapes as mode_shapes
 from .dynamics import natural_frequencies as natural_frequencies
 from .operating import OperatingPoint as OperatingPoint
+from .lubrication import thermal as thermal
+from .lubrication.friction_models import ConstantFriction as ConstantFriction
+from .lubrication.friction_models import FrictionModel as FrictionModel
+from .lubrication.friction_models import XuFriction as XuFriction
+from .lubrication.roughness import Surfaces as Surfaces

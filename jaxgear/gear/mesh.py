@@ -13,7 +13,7 @@ from .geometry import GearGeometry, gear_geometry, normal_load, radii_of_curvatu
 from .load_sharing import DEFAULT_CONTACT_SMOOTHING, share_load
 from .modification import DEFAULT_RELIEF_SMOOTHING, relief_separation
 from .pair import GearPair
-from .stiffness import pair_stiffness
+from .stiffness import STIFFNESS_METHODS, pair_stiffness
 
 
 class MeshCycle(eqx.Module):
@@ -71,17 +71,18 @@ def _safe_sqrt(x):
     return jnp.where(positive, jnp.sqrt(jnp.where(positive, x, 1.0)), 0.0)
 
 
-def contact_weight(geo: GearGeometry, s, edge_width):
+def contact_weight(geo: GearGeometry, s, edge_width: float):
     """Smooth contact flag (0 … 1) of a contact at LOA position s.
 
-    The weight rises from 0 to 1 over ``edge_width`` (m along the LOA) at each end of the path of
+    The weight rises from 0 to 1 over ``edge_width`` base pitches at each end of the path of
     contact: a model of the tip edge rounding, which makes the mesh stiffness and static TE continuous
     in time (a sharp-cornered tooth gives step changes). With edge_width = 0 it is the hard flag.
     """
     if edge_width == 0.0:
         return ((s >= geo.path_start) & (s <= geo.path_end)).astype(jnp.result_type(float))
-    t_in = (s - geo.path_start) / edge_width
-    t_out = (geo.path_end - s) / edge_width
+    width = edge_width * geo.base_pitch
+    t_in = (s - geo.path_start) / width
+    t_out = (geo.path_end - s) / width
     return _smoothstep(t_in) * _smoothstep(t_out)
 
 
@@ -115,17 +116,36 @@ def mesh_cycle(
     Returns:
         MeshCycle with arrays of shape [M] or [M, 2] (pair slots) as documented there.
     """
-    if not isinstance(n_positions, int) or n_positions < 4:
+    if isinstance(n_positions, bool) or not isinstance(n_positions, int) or n_positions < 4:
         raise ValueError(
             f"n_positions = {n_positions!r} is out of range; valid range: integer >= 4"
         )
     check_positive("torque", torque, "N m")
     check_range("edge_width", edge_width, 0.0, 0.25)
+    if stiffness not in STIFFNESS_METHODS:
+        raise ValueError(
+            f"stiffness = {stiffness!r} is not valid; valid choices: {STIFFNESS_METHODS}"
+        )
+    return _mesh_cycle(
+        pair,
+        jnp.asarray(torque, dtype=pair.module.dtype),
+        n_positions,
+        stiffness,
+        float(edge_width),
+        float(relief_smoothing),
+        float(contact_smoothing),
+    )
+
+
+@eqx.filter_jit
+def _mesh_cycle(
+    pair, torque, n_positions, stiffness, edge_width, relief_smoothing, contact_smoothing
+) -> MeshCycle:
     geo = gear_geometry(pair)
     tau = jnp.arange(n_positions) / n_positions
     slots = jnp.arange(2)
     s = geo.path_start + (tau[:, None] + slots[None, :]) * geo.base_pitch  # [M, 2]
-    weight = contact_weight(geo, s, edge_width * geo.base_pitch)
+    weight = contact_weight(geo, s, edge_width)
     inside = (s >= geo.path_start) & (s <= geo.path_end)
     # Evaluate stiffness and relief at a clipped position so out-of-path slots stay finite.
     s_eval = jnp.clip(s, geo.path_start, geo.path_end)

@@ -27,7 +27,7 @@ from .pair import GearPair, involute
 
 STIFFNESS_METHODS = ("potential_energy", "iso")
 
-_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(48)
+_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(24)
 _GL8_NODES, _GL8_WEIGHTS = np.polynomial.legendre.leggauss(8)
 
 # Sainsot et al. (2004) fillet-foundation coefficients: X* = A/θf² + B h² + C h/θf + D/θf + E h + F,

@@ -1,0 +1,1 @@
+"""Lubrication: rheology, roughness, thermal kernels, friction models and the EHL solver."""

@@ -1,0 +1,309 @@
+# ruff: noqa: F722  (jaxtyping shape strings)
+"""Rough surfaces: 1-D roughness height profiles of both gears, carried with the moving surfaces.
+
+The film thickness of paper Eq. (5) contains S1(x, t) and S2(x, t), the roughness of each surface,
+which moves with that surface's velocity uj (REFERENCE §1, §6). A :class:`Surfaces` holds one
+periodic height profile per gear, sampled on a uniform grid of spacing ``dx``, and a traced
+roughness ``scale`` (a design variable). Heights are evaluated by periodic cubic B-spline
+interpolation (C² smooth, exact at the samples), so S_j is differentiable in ``scale``, t, u_j and
+x.
+
+The paper's measured profiles are not public; :func:`gaussian_profile` synthesises Gaussian profiles
+with an exponential autocorrelation R(τ) = Rq² exp(−|τ|/β) by spectral filtering of white noise
+(REFERENCE §6). The correlation length quoted everywhere is the 10 % decay length ℓ = β ln 10.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Float
+
+from .._validation import check_finite, check_non_negative, check_positive, is_concrete
+
+DEFAULT_SPACING = 0.5e-6  # m; resolves a 20 µm correlation length with ~17 samples per β
+DEFAULT_POINTS = 8192  # 4.1 mm periodic length: longer than the contact domain of the paper's pair
+DEFAULT_CORRELATION_LENGTH = 20e-6  # m, 10 % decay length [typical], REFERENCE §6
+
+
+def _check_profile(name: str, z) -> None:
+    arr = np.asarray(z) if is_concrete(z) else None
+    if arr is None:
+        return
+    if arr.ndim != 1 or arr.size < 4:
+        raise ValueError(
+            f"{name} has shape {arr.shape}; valid: a 1-D array of at least 4 heights (m)"
+        )
+    check_finite(name, arr)
+
+
+class Surfaces(eqx.Module):
+    """Roughness of both gear surfaces (paper Eq. 5's S1, S2).
+
+    Attributes:
+        profile1: z1, heights of gear 1's surface, m, shape (n1,), periodic with period n1·dx.
+        profile2: z2, heights of gear 2's surface, m, shape (n2,), periodic with period n2·dx.
+        dx: sample spacing of both profiles, m (> 0).
+        scale: roughness scale factor (≥ 0, traced: a design variable). S_j = scale · z_j.
+        offset: x_j0 of each profile (shape (2,), m): the surface coordinate of profile sample 0 at
+            x = 0, t = 0.
+
+    Sign convention: S_j > 0 is a peak (it reduces the film, h = … − S1 − S2).
+    """
+
+    profile1: Float[Array, " n1"] = eqx.field(converter=jnp.asarray)
+    profile2: Float[Array, " n2"] = eqx.field(converter=jnp.asarray)
+    dx: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=DEFAULT_SPACING)
+    scale: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1.0)
+    offset: Float[Array, "2"] = eqx.field(
+        converter=lambda v: jnp.asarray(v, dtype=float), default=(0.0, 0.0)
+    )
+
+    def __check_init__(self):
+        _check_profile("Surfaces.profile1", self.profile1)
+        _check_profile("Surfaces.profile2", self.profile2)
+        check_positive("Surfaces.dx", self.dx, "m")
+        check_non_negative("Surfaces.scale", self.scale)
+        check_finite("Surfaces.offset", self.offset)
+
+    # -- statistics -------------------------------------------------------------------------------
+    @property
+    def rq(self) -> Float[Array, "2"]:
+        """Root-mean-square roughness of each surface (scaled, about its mean), m."""
+        return jnp.stack([_rms(self.profile1), _rms(self.profile2)]) * jnp.abs(self.scale)
+
+    @property
+    def composite_rq(self) -> Float[Array, ""]:
+        """Composite roughness σ = √(Rq1² + Rq2²), m."""
+        return jnp.sqrt(jnp.sum(self.rq**2))
+
+    # -- moving heights ---------------------------------------------------------------------------
+    def height(self, index: int, x, t, velocity) -> Float[Array, ...]:
+        """Roughness of surface ``index`` (0: gear 1, 1: gear 2) at contact-frame positions ``x``.
+
+        S_j(x, t) = scale · z_j(x − x_j0 − u_j t): the profile is carried with the surface moving at
+        ``velocity`` u_j (m/s) along +x. Periodic cubic B-spline interpolation of the samples.
+
+        Args:
+            index: 0 or 1 (static).
+            x: positions, m, any shape.
+            t: time, s (scalar).
+            velocity: u_j, m/s (scalar).
+
+        Returns:
+            Heights, m, shape of ``x``.
+        """
+        if index not in (0, 1):
+            raise ValueError(f"index = {index!r} is not valid; valid choices: 0, 1")
+        z = self.profile1 if index == 0 else self.profile2
+        xi = jnp.asarray(x) - self.offset[index] - velocity * t
+        return self.scale * periodic_cubic_interpolate(z, self.dx, xi)
+
+    def heights(self, x, t, u1, u2) -> tuple[Float[Array, ...], Float[Array, ...]]:
+        """(S1, S2) at positions ``x`` (m) and time ``t`` (s) for surface velocities u1, u2
+        (m/s)."""
+        return self.height(0, x, t, u1), self.height(1, x, t, u2)
+
+
+def _rms(z):
+    return jnp.sqrt(jnp.mean((z - jnp.mean(z)) ** 2))
+
+
+def _bspline_coefficients(z: Float[Array, " n"]) -> Float[Array, " n"]:
+    """Periodic cubic B-spline coefficients c with (c[i-1] + 4 c[i] + c[i+1]) / 6 = z[i]."""
+    n = z.shape[0]
+    k = jnp.arange(n // 2 + 1)
+    symbol = (4.0 + 2.0 * jnp.cos(2.0 * jnp.pi * k / n)) / 6.0  # ≥ 1/3: always invertible
+    return jnp.fft.irfft(jnp.fft.rfft(z) / symbol, n=n)
+
+
+def periodic_cubic_interpolate(z: Float[Array, " n"], dx, xi) -> Float[Array, ...]:
+    """Periodic cubic B-spline interpolant of samples ``z`` (spacing ``dx``, sample i at i·dx) at
+    ``xi``.
+
+    C² in ``xi``, exact at the samples; differentiable in z, dx and xi. Units follow z and xi.
+    """
+    z = jnp.asarray(z)
+    n = z.shape[0]
+    c = _bspline_coefficients(z)
+    s = jnp.asarray(xi) / dx
+    i0 = jnp.floor(s)
+    f = s - i0
+    i0 = i0.astype(jnp.int32)
+    w = (
+        (1.0 - f) ** 3 / 6.0,
+        (3.0 * f**3 - 6.0 * f**2 + 4.0) / 6.0,
+        (-3.0 * f**3 + 3.0 * f**2 + 3.0 * f + 1.0) / 6.0,
+        f**3 / 6.0,
+    )
+    out = jnp.zeros_like(f)
+    for m, wm in zip(range(-1, 3), w):
+        out = out + wm * c[jnp.mod(i0 + m, n)]
+    return out
+
+
+def exponential_psd(n: int, dx, correlation_length) -> Float[Array, " n//2+1"]:
+    """Discrete power spectrum (rfft bins) of the periodised autocorrelation exp(−|τ|/β), β = ℓ/ln
+    10.
+
+    Normalised so that white noise of unit variance filtered by √psd has unit variance.
+    """
+    beta = correlation_length / math.log(10.0)
+    m = jnp.arange(n)
+    lag = dx * jnp.minimum(m, n - m)
+    acf = jnp.exp(-lag / beta)
+    # The DFT of a positive-definite sequence is ≥ 0; clip round-off.
+    return jnp.maximum(jnp.fft.rfft(acf).real, 0.0)
+
+
+def gaussian_profile(
+    key: jax.Array,
+    n: int = DEFAULT_POINTS,
+    dx: float = DEFAULT_SPACING,
+    rq: float = 0.4e-6,
+    correlation_length: float = DEFAULT_CORRELATION_LENGTH,
+) -> Float[Array, " n"]:
+    """Synthetic Gaussian roughness profile with exponential autocorrelation (REFERENCE §6).
+
+    White noise (``jax.random.normal(key, (n,))``) is filtered in Fourier space by the square root
+    of the discrete spectrum of R(τ) = exp(−|τ|/β), β = ℓ / ln 10 (so R(ℓ) = 0.1). The mean is
+    removed and the profile is rescaled so that its sample Rq equals ``rq`` exactly; the
+    autocorrelation shape is a statistical property of the ensemble (the expected periodic
+    autocorrelation is exactly R).
+
+    Args:
+        key: ``jax.random`` key (reproducible: the same key gives the same profile).
+        n: number of samples (static).
+        dx: spacing, m.
+        rq: target root-mean-square height, m (≥ 0).
+        correlation_length: ℓ, 10 % decay length of the autocorrelation, m (> 0).
+
+    Returns:
+        Heights, m, shape (n,), periodic.
+    """
+    check_positive("dx", dx, "m")
+    check_positive("correlation_length", correlation_length, "m")
+    check_non_negative("rq", rq, "m")
+    if not isinstance(n, int | np.integer) or n < 4:
+        raise ValueError(f"n = {n!r} is not valid; valid range: integer ≥ 4")
+    noise = jax.random.normal(key, (n,), dtype=jnp.result_type(float))
+    psd = exponential_psd(n, dx, correlation_length)
+    z = jnp.fft.irfft(jnp.fft.rfft(noise) * jnp.sqrt(psd), n=n)
+    z = z - jnp.mean(z)
+    return rq * z / _rms(z)
+
+
+def _seeded_pair(seed, n, dx, rq, correlation_length):
+    k1, k2 = jax.random.split(jax.random.PRNGKey(seed))
+    return (
+        gaussian_profile(k1, n, dx, rq, correlation_length),
+        gaussian_profile(k2, n, dx, rq, correlation_length),
+    )
+
+
+def synthetic(
+    rq: float,
+    *,
+    scale=1.0,
+    seed: int = 0,
+    n: int = DEFAULT_POINTS,
+    dx: float = DEFAULT_SPACING,
+    correlation_length: float = DEFAULT_CORRELATION_LENGTH,
+) -> Surfaces:
+    """Two independent synthetic Gaussian profiles of Rq ``rq`` (m) each, seeded by ``seed``."""
+    z1, z2 = _seeded_pair(seed, n, dx, rq, correlation_length)
+    return Surfaces(profile1=z1, profile2=z2, dx=dx, scale=scale)
+
+
+def ground(scale=1.0, seed: int = 0, **kwargs) -> Surfaces:
+    """Ground gear surfaces (paper's baseline): Rq 0.40 µm per surface, ℓ 20 µm [typical, REFERENCE
+    §6]."""
+    return synthetic(0.40e-6, scale=scale, seed=seed, **kwargs)
+
+
+def polished(scale=1.0, seed: int = 0, **kwargs) -> Surfaces:
+    """Polished gear surfaces: Rq 0.05 µm per surface, ℓ 20 µm [typical, REFERENCE §6]."""
+    return synthetic(0.05e-6, scale=scale, seed=seed, **kwargs)
+
+
+def smooth(n: int = DEFAULT_POINTS, dx: float = DEFAULT_SPACING) -> Surfaces:
+    """Smooth surfaces: zero heights, with the same pytree structure and shapes as
+    :func:`ground`."""
+    z = jnp.zeros(n)
+    return Surfaces(profile1=z, profile2=z, dx=dx, scale=1.0)
+
+
+def load_profile(path: str | os.PathLike, dx: float = DEFAULT_SPACING) -> np.ndarray:
+    """Read a measured profile and resample it onto a uniform grid of spacing ``dx`` (m).
+
+    The file holds two whitespace- or comma-separated columns: position (m), height (m); lines
+    starting with ``#`` are comments. Positions must be strictly increasing. The profile is linearly
+    interpolated onto x0, x0 + dx, … (as many samples as fit in the measured span) and its mean
+    removed. The result is used as one period of a periodic profile.
+
+    Returns:
+        Heights, m, shape (n,) (NumPy array).
+
+    Raises:
+        ValueError: missing file, wrong column count, non-numeric or non-finite values,
+            non-increasing positions, a span shorter than 3 dx, or heights that look like µm
+            rather than m.
+    """
+    check_positive("dx", dx, "m")
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise ValueError(f"roughness profile file {path!r} does not exist")
+    try:
+        with open(path) as fh:
+            text = fh.read().replace(",", " ")
+        rows = [
+            ln.split() for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")
+        ]
+        data = np.array([[float(v) for v in r] for r in rows], dtype=float)
+    except ValueError as err:
+        raise ValueError(
+            f"roughness profile file {path!r}: could not parse numbers ({err}); expected "
+            "two columns: position (m), height (m)"
+        ) from None
+    if data.ndim != 2 or data.shape[1] != 2 or data.shape[0] < 4:
+        shape = data.shape if data.ndim == 2 else (len(rows),)
+        raise ValueError(
+            f"roughness profile file {path!r} has shape {shape}; valid: at least 4 rows of two "
+            "columns, position (m) and height (m)"
+        )
+    if not np.all(np.isfinite(data)):
+        raise ValueError(f"roughness profile file {path!r} contains non-finite values")
+    x, z = data[:, 0], data[:, 1]
+    if np.any(np.diff(x) <= 0.0):
+        raise ValueError(f"roughness profile file {path!r}: positions must be strictly increasing")
+    span = x[-1] - x[0]
+    n = int(np.floor(span / dx + 1e-9)) + 1
+    if n < 4:
+        raise ValueError(
+            f"roughness profile file {path!r} spans {span:g} m; valid: at least 3 dx = {3 * dx:g} m"
+        )
+    if np.max(np.abs(z)) > 1e-3:
+        raise ValueError(
+            f"roughness profile file {path!r}: heights up to {np.max(np.abs(z)):g} m; "
+            "heights must be in metres (valid range: |z| ≤ 1e-3 m; convert µm to m)"
+        )
+    zi = np.interp(x[0] + dx * np.arange(n), x, z)
+    return zi - zi.mean()
+
+
+def from_files(
+    path1: str | os.PathLike,
+    path2: str | os.PathLike,
+    *,
+    dx: float = DEFAULT_SPACING,
+    scale=1.0,
+) -> Surfaces:
+    """Surfaces from two measured profile files (see :func:`load_profile`)."""
+    return Surfaces(
+        profile1=load_profile(path1, dx), profile2=load_profile(path2, dx), dx=dx, scale=scale
+    )

@@ -1,0 +1,70 @@
+"""Matplotlib figures of jaxgear results (Agg backend; files only, no screens)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_mesh_cycle(mesh, path: str | Path) -> Path:
+    """Load share, Hertz pressure, mesh stiffness and static TE against gear 1 roll angle (PNG).
+
+    Both pair slots are unrolled onto one roll-angle axis, so the curves follow one tooth pair
+    through its whole engagement (slot 0, then slot 1 one base pitch later).
+    """
+    plt = _pyplot()
+    roll0 = np.degrees(np.asarray(mesh.roll_angle))
+    pitch_deg = roll0[1] - roll0[0]
+    span = pitch_deg * mesh.n_positions
+    roll = np.concatenate([roll0, roll0 + span])
+    inside = np.concatenate([np.asarray(mesh.in_contact[:, 0]), np.asarray(mesh.in_contact[:, 1])])
+    share = np.concatenate([np.asarray(mesh.load_share[:, 0]), np.asarray(mesh.load_share[:, 1])])
+    ph = np.concatenate(
+        [np.asarray(mesh.hertz_pressure[:, 0]), np.asarray(mesh.hertz_pressure[:, 1])]
+    )
+    keep = inside > 0
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=False)
+    axes[0, 0].plot(roll[keep], share[keep], ".-", ms=3)
+    axes[0, 0].set(
+        xlabel="gear 1 roll angle (deg)",
+        ylabel="load share of one tooth pair",
+        title="Quasi-static load sharing",
+    )
+    axes[0, 1].plot(roll[keep], ph[keep] / 1e9, ".-", ms=3)
+    axes[0, 1].set(
+        xlabel="gear 1 roll angle (deg)",
+        ylabel="Hertz pressure (GPa)",
+        title="Maximum Hertz pressure",
+    )
+    axes[1, 0].plot(roll0, np.asarray(mesh.mesh_stiffness) / 1e8, ".-", ms=3)
+    axes[1, 0].set(
+        xlabel="roll angle of the entering pair (deg)",
+        ylabel="km (1e8 N/m)",
+        title="Mesh stiffness over one mesh cycle",
+    )
+    axes[1, 1].plot(roll0, np.asarray(mesh.static_te) * 1e6, ".-", ms=3, label="loaded static TE")
+    axes[1, 1].plot(roll0, np.asarray(mesh.te_excitation) * 1e6, "--", label="TE excitation e(t)")
+    axes[1, 1].set(
+        xlabel="roll angle of the entering pair (deg)",
+        ylabel="µm",
+        title="Static transmission error",
+    )
+    axes[1, 1].legend()
+    for ax in axes.flat:
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"Mesh cycle at T1 = {float(mesh.torque):.0f} N m")
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
