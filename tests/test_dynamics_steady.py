@@ -112,6 +112,7 @@ def test_up_and_down_sweeps_show_the_contact_loss_jump():
     np.testing.assert_allclose(a_up[~band], a_down[~band], rtol=1e-5)
 
 
+@pytest.mark.slow
 def test_parallel_sweep_equals_loop_of_single_speeds():
     pair = jg.presets.li2015_pair()
     mesh = synthetic_mesh(pair, 700.0, km_amp=0.2, e_amp=4e-6)
