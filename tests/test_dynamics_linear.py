@@ -48,6 +48,7 @@ def test_natural_frequencies_match_numpy_generalised_eigenproblem():
     got = np.asarray(jg.natural_frequencies(pair, km))
     assert got[0] < 1e-3 * got[1]  # rigid-body rotation
     # Tolerance 1e-9 relative: both are double-precision eigen-solvers of a well-conditioned 6x6.
+    print("eigenfrequency max rel. difference", np.max(np.abs(got[1:] / ref[1:] - 1)))
     np.testing.assert_allclose(got[1:], ref[1:], rtol=1e-9)
     modes = jg.mode_shapes(pair, km)
     shapes = np.asarray(modes.shapes)
@@ -98,6 +99,7 @@ def test_lti_response_matches_analytic_frequency_response(lti_pair):
         assert bool(res.converged) and bool(res.stable)
         ref = analytic_dte_amplitude(pair, km, e_amp, 2 * np.pi * f_mesh)
         got = float(res.dte_harmonics[0])
+        print(f"FRF at {speed:.0f} rpm: rel. error {got / ref - 1:.2e}")
         # The brief's 1 %; the fixed-step solve is good to ~1e-6 here, so this cannot pass by slack.
         assert abs(got / ref - 1) < 1e-2, (speed, got, ref)
         # An LTI system driven at one frequency answers at that frequency only.
@@ -163,7 +165,30 @@ def test_energy_balance_over_one_steady_period():
     w_torque = (torque * om[0] - float(res.load_torque) * om[1]) * tm
     w_in = w_torque + w_exc
     dissipation = d_bear + d_tors + d_interface
+    print(
+        f"energy balance: in {w_in:.6e} J, dissipated {dissipation:.6e} J, rel. {w_in / dissipation - 1:.2e}"
+    )
     assert d_bear > 0.05 * dissipation and d_tors > 0.01 * dissipation  # all terms matter here
     # Tolerance 2e-3: the rectangle rule on M = 64 samples of the periodic (C² spline-driven) orbit
     # and the spline's interpolation of the analytic tables (~1e-5) bound the error.
     assert abs(w_in - dissipation) < 2e-3 * dissipation, (w_in, dissipation, w_torque, w_exc)
+
+
+def test_smooth_backlash_is_within_its_stated_width_of_the_exact_one():
+    from jaxgear.dynamics import backlash_exact, backlash_smooth
+
+    ell = 70e-6
+    x = np.linspace(-3 * ell, 3 * ell, 20001)
+    exact = np.asarray(backlash_exact(x, ell))
+    # exact: the three pieces written out independently
+    ref = np.where(x > ell, x - ell, np.where(x < -ell, x + ell, 0.0))
+    np.testing.assert_array_equal(exact, ref)
+    for w in (1e-6, 1e-7):
+        smooth = np.asarray(backlash_smooth(x, ell, w))
+        err = np.abs(smooth - exact)
+        # Softplus error bound w·ln 2, reached at the corners x = ±ℓ.
+        assert err.max() <= w * np.log(2) * (1 + 1e-9)
+        assert err.max() >= 0.99 * w * np.log(2)
+        # Away from the corners by 30 w the difference is below w·e^-30.
+        far = np.minimum(np.abs(x - ell), np.abs(x + ell)) > 30 * w
+        assert err[far].max() < w * np.exp(-30) * 1.01

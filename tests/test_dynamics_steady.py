@@ -24,6 +24,7 @@ def test_periodic_and_independent_of_initial_state():
     assert bool(ref.converged) and bool(ref.stable) and int(ref.status) == 0
     assert not bool(ref.contact_lost)  # away from any jump region
     # Periodicity residual of the returned orbit (independent re-integration from its start).
+    print("periodicity residual", float(ref.periodicity_residual))
     assert float(ref.periodicity_residual) < 1e-9
     # Start Newton far from the orbit: ±10 µm and ±1e4 µm/period on every state, 20 % off in T2.
     rng = np.random.default_rng(0)
@@ -147,6 +148,7 @@ def test_gradient_of_dte_rms_wrt_tip_relief_and_torque_matches_central_differenc
         xp[k] = x0[k] + h
         xm[k] = x0[k] - h
         fd = (dte_rms(*xp)[0] - dte_rms(*xm)[0]) / (2 * h)
+        print(f"gradient {k}: implicit {float(grad[k]):.6e}, central FD {float(fd):.6e}")
         # 1e-3 relative: central-difference truncation error at these steps, measured ~1e-4.
         assert abs(float(grad[k]) / float(fd) - 1) < 1e-3, (k, float(grad[k]), float(fd))
         assert abs(float(fd)) * x0[k] > 1e-3 * float(value)  # a real dependence, not noise
