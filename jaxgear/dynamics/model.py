@@ -135,7 +135,7 @@ class DynamicsOptions(eqx.Module):
     newton_batch_steps: int = eqx.field(static=True, default=8)
     newton_tol: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1e-9)
     solver: object = eqx.field(static=True, default=None)
-    transient_periods: int = eqx.field(static=True, default=60)
+    transient_periods: int = eqx.field(static=True, default=40)
     n_positions: int = eqx.field(static=True, default=64)
 
     def __check_init__(self):

@@ -37,6 +37,9 @@ STATUS_NOT_CONVERGED = 1
 STATUS_NOT_FINITE = 2
 STATUS_UNSTABLE = 3
 
+#: Members redone together by the fallback (fixed gather size).
+FALLBACK_CHUNK = 16
+
 #: Floquet multipliers up to 1 + this count as stable (the free rigid rotation has exactly 1).
 STABILITY_TOL = 1e-6
 
@@ -253,8 +256,8 @@ def _index(tree, i):
 def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None):
     """Batched periodic orbits with a per-member fallback and implicit differentiation.
 
-    Members whose Newton fails or ends on an unstable orbit are redone one at a time (a loop with a
-    scalar ``lax.cond``, so it costs nothing when unused): transients are let decay from
+    Members whose Newton fails or ends on an unstable orbit are redone, gathered in chunks (a loop
+    with a scalar predicate, so it costs nothing when unused): transients are let decay from
     ``fallback_from`` (default ``w0``) for ``options.transient_periods`` periods, then Newton again.
     The result is then passed through ``lax.custom_root`` per member, so derivatives come from the
     implicit function theorem on R = 0 and never from the iterations.
@@ -268,27 +271,35 @@ def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None):
     )
     start = w0 if fallback_from is None else fallback_from
     start = jax.lax.stop_gradient(start)
+    bsz = w.shape[0]
+    chunk = min(bsz, FALLBACK_CHUNK)
 
-    def redo(i, carry):
-        w, aux = carry
-        ok = _acceptable(_index(aux, i))
+    # Redo the members that need it in chunks of up to ``chunk`` (gathered with a fixed size, so the
+    # cost scales with the number of failures, not with the batch): transient decay, then Newton.
+    def pending(carry):
+        _, aux, tried = carry
+        return ~jax.vmap(_acceptable)(aux) & ~tried
 
-        def again():
-            dyn_i = _index(dyns_c, i)
-            w_t = _transient(dyn_i, start[i], options)
-            dyn_1 = jax.tree_util.tree_map(lambda a: a[None], dyn_i)
-            w1, aux1 = _batch_solve_newton(dyn_1, w_t[None], options, options.newton_max_steps)
-            # keep the new attempt only if it is better (acceptable, or at least converged)
-            better = _acceptable(_index(aux1, 0)) | (aux1[2][0] & ~aux[2][i])
-            w_new = jnp.where(better, w1[0], w[i])
-            aux_new = jax.tree_util.tree_map(
-                lambda a, b: a.at[i].set(jnp.where(better, b[0], a[i])), aux, aux1
-            )
-            return w.at[i].set(w_new), aux_new
+    def cond(carry):
+        return jnp.any(pending(carry))
 
-        return jax.lax.cond(ok, lambda: (w, aux), again)
+    def body(carry):
+        w, aux, tried = carry
+        idx = jnp.nonzero(pending(carry), size=chunk, fill_value=bsz)[0]
+        valid = idx < bsz
+        safe = jnp.where(valid, idx, 0)
+        dyn_k = _index(dyns_c, safe)
+        w_t = jax.vmap(lambda d, x: _transient(d, x, options))(dyn_k, start[safe])
+        w1, aux1 = _batch_solve_newton(dyn_k, w_t, options, options.newton_max_steps)
+        # Keep a new attempt only if it is better: acceptable, or at least converged.
+        better = valid & (jax.vmap(_acceptable)(aux1) | (aux1[2] & ~aux[2][safe]))
+        tgt = jnp.where(better, safe, bsz)  # out-of-range index: dropped by the scatter
+        w = w.at[tgt].set(w1, mode="drop")
+        aux = jax.tree_util.tree_map(lambda a, b: a.at[tgt].set(b, mode="drop"), aux, aux1)
+        tried = tried.at[jnp.where(valid, safe, bsz)].set(True, mode="drop")
+        return w, aux, tried
 
-    w, aux = jax.lax.fori_loop(0, w.shape[0], redo, (w, aux))
+    w, aux, _ = jax.lax.while_loop(cond, body, (w, aux, jnp.zeros(bsz, bool)))
 
     def attach(dyn, w_star):
         def identity_solve(f, x):
