@@ -399,6 +399,26 @@ def _check_inputs(pair, op):
         check_positive("blank_inertia", pair.blank_inertia, "kg m^2")
 
 
+def _canonical(tree):
+    """Floating leaves as strong-typed default-float arrays, so that equal shapes share one compiled
+    function whatever Python or weak types the caller used."""
+    ftype = jnp.result_type(float)
+
+    def conv(x):
+        if isinstance(x, float) or (eqx.is_array(x) and jnp.issubdtype(x.dtype, jnp.floating)):
+            return jnp.asarray(x, dtype=ftype)
+        return x
+
+    return jax.tree_util.tree_map(conv, tree)
+
+
+def _prepare(pair, op, mesh, interface, options):
+    if interface is None:
+        m = options.n_positions if mesh is None else mesh.n_positions
+        interface = MeshInterface.zeros(m)
+    return _canonical((pair, op, mesh, interface, options))
+
+
 def _mesh_and_interface(pair, op, mesh, interface, options):
     if mesh is None:
         from ..gear.mesh import mesh_cycle  # provided by the gear-mesh issue
@@ -452,6 +472,7 @@ def dynamic_response(
     _check_inputs(pair, op)
     # NaN marks "no guess" so that passing a guess or not shares one compiled function.
     guess = jnp.full(13, jnp.nan) if initial_state is None else jnp.asarray(initial_state, float)
+    pair, op, mesh, interface, options = _prepare(pair, op, mesh, interface, options)
     return _dynamic_response_jit(pair, op, mesh, interface, options, guess)
 
 
@@ -537,6 +558,7 @@ def dynamic_response_sweep(
         raise ValueError(f"speeds_rpm must be a non-empty 1-D array; got shape {speeds.shape}")
     check_positive("speeds_rpm", speeds, "rpm")
     _check_inputs(pair, op)
+    pair, op, mesh, interface, options = _prepare(pair, op, mesh, interface, options)
     if mode == "parallel":
         return _sweep_parallel(pair, op, speeds, mesh, interface, options)
     if mode == "continuation":
