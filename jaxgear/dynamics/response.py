@@ -253,12 +253,14 @@ def _index(tree, i):
     return jax.tree_util.tree_map(lambda a: a[i], tree)
 
 
-def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None):
+def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None, retry_unstable=True):
     """Batched periodic orbits with a per-member fallback and implicit differentiation.
 
     Members whose Newton fails or ends on an unstable orbit are redone, gathered in chunks (a loop
     with a scalar predicate, so it costs nothing when unused): transients are let decay from
     ``fallback_from`` (default ``w0``) for ``options.transient_periods`` periods, then Newton again.
+    ``retry_unstable`` (traced bool) = False redoes only members whose Newton failed, not those that
+    converged to an unstable orbit (a continuation inside a band without a stable orbit).
     The result is then passed through ``lax.custom_root`` per member, so derivatives come from the
     implicit function theorem on R = 0 and never from the iterations.
     """
@@ -278,7 +280,8 @@ def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None):
     # cost scales with the number of failures, not with the batch): transient decay, then Newton.
     def pending(carry):
         _, aux, tried = carry
-        return ~jax.vmap(_acceptable)(aux) & ~tried
+        need = ~aux[2] | (retry_unstable & ~jax.vmap(_acceptable)(aux))
+        return need & ~tried
 
     def cond(carry):
         return jnp.any(pending(carry))
@@ -508,7 +511,7 @@ def _sweep_continuation(pair, op, speeds, mesh, interface, options):
     mesh, interface = _mesh_and_interface(pair, op, mesh, interface, options)
 
     def step(carry, speed):
-        w_prev, speed_prev, have_prev = carry
+        w_prev, speed_prev, have_prev, prev_stable = carry
         op_n = _at_speed(op, speed)
         dyn = build_dynamics(pair, op_n, mesh, interface, options)
         cold = static_guess(dyn)
@@ -517,14 +520,21 @@ def _sweep_continuation(pair, op, speeds, mesh, interface, options):
         # unstable orbit is left), the state left by the previous speed decays to the new attractor:
         # this is the jump.
         batch = jax.tree_util.tree_map(lambda a: a[None], dyn)
-        w, aux = _batch_solve(batch, guess[None], options)
+        # Inside a band where the previous speed had no stable orbit either, an unstable orbit is
+        # accepted without the (costly, futile) transient retry.
+        w, aux = _batch_solve(batch, guess[None], options, retry_unstable=~have_prev | prev_stable)
         w, aux = w[0], _index(aux, 0)
         res = _postprocess(dyn, mesh, op_n, w, aux, options)
         ok = res.converged
-        new_carry = (jnp.where(ok, w, w_prev), jnp.where(ok, speed, speed_prev), have_prev | ok)
+        new_carry = (
+            jnp.where(ok, w, w_prev),
+            jnp.where(ok, speed, speed_prev),
+            have_prev | ok,
+            res.stable | ~ok,
+        )
         return new_carry, res
 
-    init = (jnp.zeros(13), speeds[0], jnp.asarray(False))
+    init = (jnp.zeros(13), speeds[0], jnp.asarray(False), jnp.asarray(True))
     _, out = jax.lax.scan(step, init, speeds)
     return out
 
