@@ -525,12 +525,14 @@ def _sweep_continuation(pair, op, speeds, mesh, interface, options):
         w, aux = _batch_solve(batch, guess[None], options, retry_unstable=~have_prev | prev_stable)
         w, aux = w[0], _index(aux, 0)
         res = _postprocess(dyn, mesh, op_n, w, aux, options)
-        ok = res.converged
+        # Carry only stable orbits: an unstable one (inside a band without a stable periodic orbit)
+        # is not what the gears settle on and may sit far from it.
+        ok = res.converged & res.stable
         new_carry = (
             jnp.where(ok, w, w_prev),
             jnp.where(ok, speed, speed_prev),
             have_prev | ok,
-            res.stable | ~ok,
+            res.stable | ~res.converged,
         )
         return new_carry, res
 
