@@ -16,3 +16,8 @@ from .gear.pair import TipRelief as TipRelief
 from .material import Material as Material
 
 __version__ = "0.1.0"
+from .lubrication.ehl import EHLModel as EHLModel
+from .lubrication.ehl import EHLSolution as EHLSolution
+from .lubrication.ehl import LineContact as LineContact
+from .lubrication.ehl import solve_ehl as solve_ehl
+from .lubrication.lubricant import Lubricant as Lubricant

@@ -31,3 +31,5 @@ def li2015_pair(tip_relief: float = 10e-6, relief_start_deg: float = 20.9) -> Ge
             amount=tip_relief, start_roll_angle=math.radians(relief_start_deg), shape="linear"
         ),
     )
+from .lubrication.lubricant import iso_vg68 as iso_vg68  # noqa: E402
+from .lubrication.lubricant import mil_l_23699 as mil_l_23699  # noqa: E402

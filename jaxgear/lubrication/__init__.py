@@ -1,0 +1,8 @@
+"""Lubrication: lubricant rheology, elastic deformation, the Reynolds equation and the EHL
+solver."""
+
+from .ehl import EHLModel as EHLModel
+from .ehl import EHLSolution as EHLSolution
+from .ehl import LineContact as LineContact
+from .ehl import solve_ehl as solve_ehl
+from .lubricant import Lubricant as Lubricant
