@@ -49,7 +49,11 @@ def influence_matrix(n: int, spacing):
     Returns:
         (n, n) array; the film is H = H0 + X²/2 + D @ P.
     """
-    k0 = jnp.asarray(unit_matrix(n))
+    k = jnp.asarray(unit_kernel(n))
+    idx = jnp.arange(n)
+    k0 = k[
+        jnp.abs(idx[:, None] - idx[None, :])
+    ]  # gathered at run time: no N² constant in the program
     return -(spacing / jnp.pi) * (k0 + jnp.log(spacing))
 
 

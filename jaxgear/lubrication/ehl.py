@@ -48,7 +48,6 @@ from . import rheology
 from .lubricant import Lubricant
 from .reynolds import (
     fischer_burmeister,
-    log_smooth_positive,
     reynolds_residual,
     smooth_positive,
 )
@@ -58,7 +57,7 @@ COMPRESSIBILITY_MODELS = ("dowson_higginson", "incompressible")
 SHEAR_MODELS = ("newtonian", "eyring_paper", "eyring_exact")
 DEFORMATION_METHODS = ("dense", "fft", "auto")
 
-_LOG_VISCOSITY_CAP = 500.0  # soft cap on ln(η/η0): keeps iterates finite (η/η0 ≤ e^500)
+_LOG_VISCOSITY_CAP = 500.0  # cap on ln(η/η0): keeps iterates finite (η/η0 ≤ e^500)
 _FLOOR_FRACTION = 1e-3  # smooth film floor inside ε, relative to the reference film
 
 
@@ -391,14 +390,18 @@ class _Level(eqx.Module):
                 pressure, self.log_eta0_nodes, self.inp.lubricant.roelands_z
             )
         log_eta = s * log_eta
-        log_eta = _LOG_VISCOSITY_CAP - jax.nn.softplus(_LOG_VISCOSITY_CAP - log_eta)
+        log_eta = jnp.minimum(log_eta, _LOG_VISCOSITY_CAP)
         if m.compressibility == "dowson_higginson":
             rho = self.rho_nodes * rheology.dowson_higginson_density(pressure, 0.0, 1.0, 0.0, 0.0)
         else:
             rho = self.rho_nodes
-        log_h = log_smooth_positive(h, _FLOOR_FRACTION * sc.h_ref)
-        log_eta_s = log_eta + _log_shear_factor(m, sc.log_kappa + log_eta - log_h)
-        log_eps = jnp.log(rho) + 3.0 * log_h - log_eta_s - sc.log_lambda
+        h_eff = smooth_positive(h, _FLOOR_FRACTION * sc.h_ref)
+        if m.shear == "newtonian":
+            log_eta_s = log_eta
+        else:
+            log_s = sc.log_kappa + log_eta - jnp.log(h_eff)
+            log_eta_s = log_eta + _log_shear_factor(m, log_s)
+        log_eps = jnp.log(rho * h_eff**3) - log_eta_s - sc.log_lambda
         r, diag = reynolds_residual(
             p, rho * h, log_eps, self.spacing, sc.squeeze, self.rho_h_prev, m.wedge_order
         )
@@ -537,27 +540,27 @@ def _transfer(coarse: _Level, fine: _Level, u):
     return jnp.concatenate([p, h0[None]])
 
 
-def _cold_solve(model: EHLModel, levels: list[_Level]):
+def _cold_start(model: EHLModel, levels: list[_Level]):
+    """Continuation in the piezo-viscous exponent on the coarsest grid, then grid sequencing up to the
+    second-finest grid; returns the fine-grid starting point and the Newton iterations spent."""
     coarse = levels[0]
     u = _hertz_start(coarse)
+    if len(levels) == 1:
+        return u, jnp.asarray(0)
     steps = model.continuation_steps
     svals = jnp.arange(1, steps + 1, dtype=u.dtype) / steps
 
     def cont(carry, s):
         u, it = carry
-        u_new, res, k, ok = _newton(coarse, u, s, model.max_iterations)
+        u_new, _, k, _ = _newton(coarse, u, s, model.max_iterations)
         return (u_new, it + k), None
 
     (u, iters), _ = jax.lax.scan(cont, (u, jnp.asarray(0)), svals)
-    res = jnp.asarray(jnp.inf)
-    ok = jnp.asarray(False)
-    for prev, lev in zip(levels[:-1], levels[1:], strict=False):
+    for prev, lev in zip(levels[:-2], levels[1:-1], strict=False):
         u = _transfer(prev, lev, u)
-        u, res, k, ok = _newton(lev, u, 1.0, model.max_iterations)
+        u, _, k, _ = _newton(lev, u, 1.0, model.max_iterations)
         iters = iters + k
-    if len(levels) == 1:
-        _, res, _, ok = _newton(coarse, u, 1.0, 0)
-    return u, res, iters, ok
+    return _transfer(levels[-2], levels[-1], u), iters
 
 
 # -------------------------------------------------------------------------------------------------
@@ -579,23 +582,43 @@ def _warm_start(fine: _Level, init_x, init_p, init_h0):
 
 @functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1))
 def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_h0):
-    """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats."""
+    """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats.
+
+    The fine-grid Newton loop appears once in the program: a warm solve is a scan over two attempts
+    (the warm start, then, only if that failed, the cold start), so compile time does not double."""
     sc, levels = _levels(model, inp)
     fine = levels[-1]
-    if warm:
-        u0 = _warm_start(fine, init_x, init_p, init_h0)
-        u_w, res_w, it_w, ok_w = _newton(fine, u0, 1.0, model.warm_iterations)
-
-        def keep(_):
-            return u_w, res_w, it_w, ok_w
-
-        def cold(_):
-            u_c, res_c, it_c, ok_c = _cold_solve(model, levels)
-            return u_c, res_c, it_c + it_w, ok_c
-
-        u, res, it, ok = jax.lax.cond(ok_w, keep, cold, None)
+    if not warm:
+        u0, it0 = _cold_start(model, levels)
+        u, res, k, ok = _newton(fine, u0, 1.0, model.max_iterations)
+        it = it0 + k
     else:
-        u, res, it, ok = _cold_solve(model, levels)
+        u_warm = _warm_start(fine, init_x, init_p, init_h0)
+
+        def attempt(carry, first):
+            u, res, it, ok = carry
+
+            def cold(_):
+                return _cold_start(model, levels)
+
+            def again(_):
+                return u, jnp.asarray(0)
+
+            start, k0 = jax.lax.cond(first | ok, again, cold, None)
+            start = jnp.where(first, u_warm, start)
+            max_iter = jnp.where(
+                first, model.warm_iterations, jnp.where(ok, 0, model.max_iterations)
+            )
+            u1, res1, k1, ok1 = _newton(fine, start, 1.0, max_iter)
+            return (u1, res1, it + k0 + k1, ok1), None
+
+        init = (
+            u_warm,
+            jnp.asarray(jnp.inf, dtype=u_warm.dtype),
+            jnp.asarray(0),
+            jnp.asarray(False),
+        )
+        (u, res, it, ok), _ = jax.lax.scan(attempt, init, jnp.array([True, False]))
     finite = jnp.all(jnp.isfinite(u))
     fallback = _hertz_start(fine)
     u = jnp.where(finite, u, fallback)
