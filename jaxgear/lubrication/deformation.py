@@ -57,6 +57,14 @@ def influence_matrix(n: int, spacing):
     return -(spacing / jnp.pi) * (k0 + jnp.log(spacing))
 
 
+def influence_vector(n: int, spacing, pad: int = 0):
+    """The Toeplitz generator d(m) of ``influence_matrix`` (D[i, j] = d(i − j)) for
+    m = −(n − 1 + pad) … n − 1 + pad, as a 1-D array of length 2(n + pad) − 1."""
+    k = unit_kernel(n + pad)
+    full = np.concatenate([k[:0:-1], k])
+    return -(spacing / jnp.pi) * (jnp.asarray(full) + jnp.log(spacing))
+
+
 def deformation_dense(pressure, spacing):
     """V = D @ P with the dense influence matrix (Hertz-scaled)."""
     return influence_matrix(pressure.shape[-1], spacing) @ pressure

@@ -264,12 +264,18 @@ class _Inputs(eqx.Module):
 # Dimensionless problem
 # -------------------------------------------------------------------------------------------------
 def moes_central_film(m, l):
-    """Moes' central film H_M = (hc/R)(2U)^(−1/2) for given M, L (REFERENCE §8)."""
+    """Moes' central film H_M = (hc/R)(2U)^(−1/2) for given M, L (line contact, Barus, incompressible).
+
+    H_RI = 3/M, H_EI = 2.621 M^(−1/5), H_RP = 1.287 L^(2/3), H_EP = 1.311 M^(−1/8) L^(3/4),
+    H_M = [(H_RI^(7/3) + H_EI^(7/3))^(3s/7) + (H_RP^(−7/2) + H_EP^(−7/2))^(−2s/7)]^(1/s) with
+    s = (7 + 8 exp(−2 H_EI/H_RI))/5 (C.H. Venner & A.A. Lubrecht, Multilevel Methods in Lubrication,
+    2000). Used here only as the starting estimate of the film.
+    """
     h_ri = 3.0 / m
     h_ei = 2.621 * m ** (-0.2)
     h_rp = 1.287 * l ** (2.0 / 3.0)
     h_ep = 1.311 * m ** (-0.125) * l**0.75
-    s = (7.0 + 8.0 * jnp.exp(-2.0 * l * m ** (-0.4))) / 5.0
+    s = (7.0 + 8.0 * jnp.exp(-2.0 * h_ei / h_ri)) / 5.0
     a = (h_ri ** (7.0 / 3.0) + h_ei ** (7.0 / 3.0)) ** (3.0 * s / 7.0)
     b = (h_rp ** (-3.5) + h_ep ** (-3.5)) ** (-2.0 * s / 7.0)
     return (a + b) ** (1.0 / s)
@@ -426,16 +432,21 @@ class _Level(eqx.Module):
         jp = jax.vmap(lin)(seeds, zero)  # (4, n): row i, coloured column
         jh = jax.vmap(lin)(zero, seeds)
         rows = jnp.arange(n)
-        dense = jnp.zeros((n, n), dtype=p.dtype)
-        h0_col = jnp.zeros(n, dtype=p.dtype)
-        for k in (-2, -1, 0, 1):
+        offsets = (-2, -1, 0, 1)
+        dps, dhs = [], []
+        for k in offsets:
             col = rows + k
             valid = (col >= 0) & (col < n)
-            dp = jnp.where(valid, jp[col % 4, rows], 0.0)
-            dh = jnp.where(valid, jh[col % 4, rows], 0.0)
-            dense = dense.at[rows, jnp.clip(col, 0, n - 1)].add(dp)
-            dense = dense + dh[:, None] * jnp.roll(self.kernel, -k, axis=0)
-            h0_col = h0_col + dh
+            dps.append(jnp.where(valid, jp[col % 4, rows], 0.0))
+            dhs.append(jnp.where(valid, jh[col % 4, rows], 0.0))
+        # J[i, j] = Σ_k dP_k[i] [j = i + k] + Σ_k dH_k[i] D[i + k, j], with the Toeplitz influence
+        # matrix D[i, j] = d(i − j) read from a padded 1-D kernel: one fused pass over n² entries.
+        kern = deformation_mod.influence_vector(n, self.spacing, pad=2)  # d(m), m = −(n+1) … n+1
+        m = rows[:, None] - rows[None, :]
+        dense = jnp.zeros((n, n), dtype=p.dtype)
+        for k, dp, dh in zip(offsets, dps, dhs, strict=True):
+            dense = dense + dh[:, None] * kern[m + k + n + 1] + jnp.where(m == -k, dp[:, None], 0.0)
+        h0_col = sum(dhs)
         top = jnp.concatenate([dense, h0_col[:, None]], axis=1)
         bottom = jnp.concatenate(
             [jnp.full((1, n), self.spacing / (0.5 * jnp.pi), dtype=p.dtype), jnp.zeros((1, 1))],
@@ -545,10 +556,12 @@ def _cold_start(model: EHLModel, levels: list[_Level]):
     second-finest grid; returns the fine-grid starting point and the Newton iterations spent."""
     coarse = levels[0]
     u = _hertz_start(coarse)
-    if len(levels) == 1:
-        return u, jnp.asarray(0)
     steps = model.continuation_steps
-    svals = jnp.arange(1, steps + 1, dtype=u.dtype) / steps
+    # a single grid stops the continuation short of s = 1: the fine solve that follows finishes it
+    last = steps + 1 if len(levels) > 1 else steps
+    if last <= 1:
+        return u, jnp.asarray(0)
+    svals = jnp.arange(1, last, dtype=u.dtype) / steps
 
     def cont(carry, s):
         u, it = carry
@@ -556,6 +569,8 @@ def _cold_start(model: EHLModel, levels: list[_Level]):
         return (u_new, it + k), None
 
     (u, iters), _ = jax.lax.scan(cont, (u, jnp.asarray(0)), svals)
+    if len(levels) == 1:
+        return u, iters
     for prev, lev in zip(levels[:-2], levels[1:-1], strict=False):
         u = _transfer(prev, lev, u)
         u, _, k, _ = _newton(lev, u, 1.0, model.max_iterations)
@@ -619,6 +634,8 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
             jnp.asarray(False),
         )
         (u, res, it, ok), _ = jax.lax.scan(attempt, init, jnp.array([True, False]))
+    # a closed (non-positive) film is not a smooth-EHL solution, however small the residual: report it
+    ok = ok & (jnp.min(fine.film(u)) > 0.0)
     finite = jnp.all(jnp.isfinite(u))
     fallback = _hertz_start(fine)
     u = jnp.where(finite, u, fallback)
