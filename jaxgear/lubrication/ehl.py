@@ -156,7 +156,7 @@ class EHLModel(eqx.Module):
     tolerance: float = eqx.field(static=True, default=1e-9)
     max_iterations: int = eqx.field(static=True, default=30)
     coarsest_nodes: int = eqx.field(static=True, default=65)
-    continuation_steps: int = eqx.field(static=True, default=4)
+    continuation_steps: int = eqx.field(static=True, default=10)
     warm_iterations: int = eqx.field(static=True, default=12)
     deformation: str = eqx.field(static=True, default="auto")
     wedge_order: int = eqx.field(static=True, default=2)
@@ -690,9 +690,14 @@ def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
     fill = jnp.where(x > 0.0, jnp.minimum(1.0, q / (sc.um * rho_h)), 1.0)
     weights = jnp.full((n,), dx).at[0].set(0.5 * dx).at[-1].set(0.5 * dx)
     q_slide = fill * eta_s * sc.us**2 / h_eff  # paper Eq. (12), sliding part
-    q_roll = h_eff**3 / (12.0 * eta_s) * dpdx**2  # paper Eq. (12), rolling (Poiseuille) part
+    # Poiseuille terms on cell faces, as the Reynolds discretisation has them (flow coefficient
+    # averaged to the face, pressure gradient by the face difference)
+    flow = h_eff**3 / (12.0 * eta_s)
+    dp_face = jnp.diff(p_dim) / dx
+    q_roll_face = 0.5 * (flow[1:] + flow[:-1]) * dp_face**2  # paper Eq. (12), rolling part
+    q_roll = 0.5 * (jnp.pad(q_roll_face, (1, 0)) + jnp.pad(q_roll_face, (0, 1)))
     fs = jnp.sum(weights * fill * eta_s * (c.u2 - c.u1) / h_eff)  # paper Eq. (15)
-    fr = jnp.sum(weights * 0.5 * h * dpdx)  # paper Eq. (15)
+    fr = jnp.sum(0.25 * (h[1:] + h[:-1]) * jnp.diff(p_dim))  # paper Eq. (15): ∫ (h/2) ∂p/∂x dx
     cm = jnp.sum(weights * fill * eta_s / h_eff)  # paper Eq. (13) per unit width
     # sub-grid minimum film by a parabola through the smallest node and its neighbours
     i = jnp.clip(jnp.argmin(big_h), 1, n - 2)
@@ -720,9 +725,9 @@ def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
         friction_sliding=fs,
         friction_rolling=fr,
         damping=cm,
-        power_loss=jnp.sum(weights * (q_slide + q_roll)),
+        power_loss=jnp.sum(weights * q_slide) + jnp.sum(q_roll_face) * dx,
         power_loss_sliding=jnp.sum(weights * q_slide),
-        power_loss_rolling=jnp.sum(weights * q_roll),
+        power_loss_rolling=jnp.sum(q_roll_face) * dx,
         load_error=load_err,
         hertz_half_width=sc.b,
         hertz_pressure=sc.ph,
