@@ -136,7 +136,8 @@ class EHLModel(eqx.Module):
         tolerance: ‖F‖∞ below which a Newton solve has converged.
         max_iterations: Newton iterations per grid level (and per continuation step).
         coarsest_nodes: smallest grid of the sequence.
-        continuation_steps: steps of the piezo-viscous exponent (s = 1/n … 1) on the coarsest grid.
+        continuation_steps: steps of the piezo-viscous exponent (s = 1/n … 1) on the coarsest grid
+            in the second cold attempt (the first uses s = 1/4, 1/2, 3/4, 1).
         warm_iterations: Newton iterations allowed for a warm start before falling back to a cold
         solve.
         deformation: "dense", "fft" (DC-FFT for residuals; the Jacobian stays dense), "auto" (fft
@@ -156,7 +157,7 @@ class EHLModel(eqx.Module):
     tolerance: float = eqx.field(static=True, default=1e-9)
     max_iterations: int = eqx.field(static=True, default=30)
     coarsest_nodes: int = eqx.field(static=True, default=65)
-    continuation_steps: int = eqx.field(static=True, default=10)
+    continuation_steps: int = eqx.field(static=True, default=12)
     warm_iterations: int = eqx.field(static=True, default=12)
     deformation: str = eqx.field(static=True, default="auto")
     wedge_order: int = eqx.field(static=True, default=2)
@@ -502,6 +503,9 @@ def _newton(level: _Level, u0, s, max_iter: int):
         jac = level.jacobian(u, s)
         d = jnp.linalg.solve(jac, -f)
         d = jnp.where(jnp.isfinite(d), d, 0.0)
+        # cap the film-offset change per step: a runaway H0 is the usual way a far start diverges
+        cap = 0.5 * jnp.maximum(jnp.abs(u[-1]), 10.0 * level.sc.h_ref)
+        d = d * jnp.minimum(1.0, cap / jnp.maximum(jnp.abs(d[-1]), 1e-300))
 
         # backtracking α = 1, 1/2, … (Armijo on ½‖F‖²); one call site keeps the compiled loop small
         def ls_cond(ls):
@@ -551,17 +555,23 @@ def _transfer(coarse: _Level, fine: _Level, u):
     return jnp.concatenate([p, h0[None]])
 
 
-def _cold_start(model: EHLModel, levels: list[_Level]):
-    """Continuation in the piezo-viscous exponent on the coarsest grid, then grid sequencing up to the
-    second-finest grid; returns the fine-grid starting point and the Newton iterations spent."""
+def _schedules(model: EHLModel, dtype):
+    """Continuation schedules of the piezo-viscous exponent s, one row per cold attempt: four plateaus
+    1/4, 1/2, 3/4, 1 first (repeated values cost nothing: Newton stops at once when converged), then,
+    if that failed, ``continuation_steps`` equal steps."""
+    k = model.continuation_steps
+    i = np.arange(1, k + 1)
+    return jnp.asarray(np.stack([np.ceil(4.0 * i / k) / 4.0, i / k]), dtype=dtype)
+
+
+def _cold_start(model: EHLModel, levels: list[_Level], svals):
+    """Continuation in the piezo-viscous exponent s (schedule ``svals``) on the coarsest grid, then grid
+    sequencing up to the second-finest grid; returns the fine-grid start and the iterations spent."""
     coarse = levels[0]
     u = _hertz_start(coarse)
-    steps = model.continuation_steps
-    # a single grid stops the continuation short of s = 1: the fine solve that follows finishes it
-    last = steps + 1 if len(levels) > 1 else steps
-    if last <= 1:
-        return u, jnp.asarray(0)
-    svals = jnp.arange(1, last, dtype=u.dtype) / steps
+    if len(levels) == 1:
+        # a single grid stops short of s = 1: the fine solve that follows finishes it
+        svals = svals * (1.0 - 1.0 / (svals.shape[0] + 1.0))
 
     def cont(carry, s):
         u, it = carry
@@ -603,37 +613,37 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
     (the warm start, then, only if that failed, the cold start), so compile time does not double."""
     sc, levels = _levels(model, inp)
     fine = levels[-1]
-    if not warm:
-        u0, it0 = _cold_start(model, levels)
-        u, res, k, ok = _newton(fine, u0, 1.0, model.max_iterations)
-        it = it0 + k
-    else:
-        u_warm = _warm_start(fine, init_x, init_p, init_h0)
+    dtype = fine.x.dtype
+    schedules = _schedules(model, dtype)
+    # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule; each runs only
+    # if everything before it failed (lax.cond: no work when skipped, outside vmap)
+    n_cold = schedules.shape[0]
+    kinds = jnp.asarray(([0] if warm else []) + list(range(1, n_cold + 1)))
+    u_warm = _warm_start(fine, init_x, init_p, init_h0) if warm else _hertz_start(fine)
 
-        def attempt(carry, first):
-            u, res, it, ok = carry
+    def attempt(carry, kind):
+        u, res, it, ok = carry
 
-            def cold(_):
-                return _cold_start(model, levels)
+        def cold(_):
+            row = jnp.clip(kind - 1, 0, n_cold - 1)
+            return _cold_start(model, levels, schedules[row])
 
-            def again(_):
-                return u, jnp.asarray(0)
+        def keep(_):
+            return u, jnp.asarray(0)
 
-            start, k0 = jax.lax.cond(first | ok, again, cold, None)
-            start = jnp.where(first, u_warm, start)
-            max_iter = jnp.where(
-                first, model.warm_iterations, jnp.where(ok, 0, model.max_iterations)
-            )
-            u1, res1, k1, ok1 = _newton(fine, start, 1.0, max_iter)
-            return (u1, res1, it + k0 + k1, ok1), None
+        start, k0 = jax.lax.cond(ok | (kind == 0), keep, cold, None)
+        start = jnp.where(kind == 0, u_warm, start)
+        budget = model.warm_iterations if warm else model.max_iterations
+        max_iter = jnp.where(ok, 0, jnp.where(kind == 0, budget, model.max_iterations))
+        u1, res1, k1, ok1 = _newton(fine, start, 1.0, max_iter)
+        u1 = jnp.where(ok, u, u1)
+        res1 = jnp.where(ok, res, res1)
+        # a closed film is a failure: try the next attempt
+        ok1 = (ok | ok1) & (jnp.min(fine.film(u1)) > 0.0)
+        return (u1, res1, it + k0 + k1, ok1), None
 
-        init = (
-            u_warm,
-            jnp.asarray(jnp.inf, dtype=u_warm.dtype),
-            jnp.asarray(0),
-            jnp.asarray(False),
-        )
-        (u, res, it, ok), _ = jax.lax.scan(attempt, init, jnp.array([True, False]))
+    init = (u_warm, jnp.asarray(jnp.inf, dtype=dtype), jnp.asarray(0), jnp.asarray(False))
+    (u, res, it, ok), _ = jax.lax.scan(attempt, init, kinds)
     # a closed (non-positive) film is not a smooth-EHL solution, however small the residual: report it
     ok = ok & (jnp.min(fine.film(u)) > 0.0)
     finite = jnp.all(jnp.isfinite(u))
