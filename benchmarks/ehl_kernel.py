@@ -1,8 +1,10 @@
-"""Benchmark of the EHL line-contact kernel (issue 3): compile and run times, Newton iterations and grid
+"""Benchmark of the EHL line-contact kernel (issue 3): compile and run times, Newton iterations and
+grid
 error, cold and warm-started, single and vmapped, plus the implicit-gradient cost.
 
 Run: ``python benchmarks/ehl_kernel.py`` (writes its section of benchmarks/RESULTS.md).
-Contacts: the paper's pair at the pitch point (REFERENCE §2-3), Mil-L-23699 at 90 °C, 700 N m, 2000 rpm,
+Contacts: the paper's pair at the pitch point (REFERENCE §2-3), Mil-L-23699 at 90 °C, 700 N m, 2000
+rpm,
 slide-to-roll 0.3 (M ≈ 36, L ≈ 5.6); warm starts from the neighbouring mesh position (load +3 %,
 radius +2 %, speed +1 %); the high-load case is 1500 N m at 190 rpm (M ≈ 250).
 """
@@ -165,7 +167,7 @@ def machine():
         pass
     load = os.getloadavg() if hasattr(os, "getloadavg") else ("?",)
     return (
-        f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}; jax {jax.__version__}; "
+        f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}; jax {jax.__version__}; "  # noqa: E501
         f"float64; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}; "
         f"load average at the end {load[0]:.1f} (CPU shared with other jobs)"
     )
@@ -199,11 +201,11 @@ def write_results(
         "",
         f"Machine: {machine()}. Date: {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC.",
         "Medians of 7 runs after `block_until_ready`; compile = first call − median run.",
-        "Contact: the paper's pair at the pitch point, 700 N m, 2000 rpm, SR 0.3, Mil-L-23699 at 90 °C "
-        "(M ≈ 36, L ≈ 5.6); default physics (Roelands, Dowson-Higginson, paper Eyring η*). Warm: the "
-        "neighbouring mesh position (load +3 %, R +2 %, speed +1 %) started from the cold solution.",
+        "Contact: the paper's pair at the pitch point, 700 N m, 2000 rpm, SR 0.3, Mil-L-23699 at 90 °C "  # noqa: E501
+        "(M ≈ 36, L ≈ 5.6); default physics (Roelands, Dowson-Higginson, paper Eyring η*). Warm: the "  # noqa: E501
+        "neighbouring mesh position (load +3 %, R +2 %, speed +1 %) started from the cold solution.",  # noqa: E501
         "",
-        "| N | compile cold (s) | cold run (ms) | Newton it. cold | compile warm (s) | warm run (ms) "
+        "| N | compile cold (s) | cold run (ms) | Newton it. cold | compile warm (s) | warm run (ms) "  # noqa: E501
         "| Newton it. warm | converged | err h_min | err h_c | err Fs | err power |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
@@ -221,15 +223,15 @@ def write_results(
         f"- High load: 1500 N m, 190 rpm (M = {m_heavy:.0f}), N = 1025, cold: {ms(hv_run)} ms, "
         f"{hv_it} Newton iterations over all levels, converged = {hv_ok} (target ≤ 300 ms).",
         f"- vmap, 64 contacts along a mesh-like path (load, R ±20 %, SR varying), N = 257: cold "
-        f"{ms(v_run)} ms per batch = {ms(v_run / 64)} ms per contact (max {v_it} iterations, all converged = "
-        f"{v_ok}; compile {v_compile:.1f} s); warm-started from the previous batch {ms(vw_run)} ms = "
+        f"{ms(v_run)} ms per batch = {ms(v_run / 64)} ms per contact (max {v_it} iterations, all converged = "  # noqa: E501
+        f"{v_ok}; compile {v_compile:.1f} s); warm-started from the previous batch {ms(vw_run)} ms = "  # noqa: E501
         f"{ms(vw_run / 64)} ms per contact (max {vw_it} it., all converged = {vw_ok}); "
         f"the same 64 cold solves in a Python loop: {ms(loop_run)} ms.",
-        f"- Implicit gradient d(h_c, Fs)/dw' at N = 257: forward {ms(f_run)} ms, grad {ms(g_run)} ms "
+        f"- Implicit gradient d(h_c, Fs)/dw' at N = 257: forward {ms(f_run)} ms, grad {ms(g_run)} ms "  # noqa: E501
         f"(ratio {g_run / f_run:.2f}; value_and_grad {ms(vg_run)} ms, ratio {vg_run / f_run:.2f}); "
         f"grad compile {g_compile:.1f} s. Target ≤ 3×.",
-        "- Reference point (not re-measured here): a straightforward NumPy dense-Newton solver with grid "
-        "sequencing takes about 100 ms at N = 257 and 2 s at N = 1025 on this class of CPU (issue 3).",
+        "- Reference point (not re-measured here): a straightforward NumPy dense-Newton solver with grid "  # noqa: E501
+        "sequencing takes about 100 ms at N = 257 and 2 s at N = 1025 on this class of CPU (issue 3).",  # noqa: E501
         "<!-- END ehl_kernel -->",
     ]
     section = "\n".join(lines)

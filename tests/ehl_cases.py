@@ -1,4 +1,5 @@
-"""Contacts shared by the EHL tests: the paper's pitch-point contact and contacts of given Moes M, L.
+"""Contacts shared by the EHL tests: the paper's pitch-point contact and contacts of given Moes M,
+L.
 
 Everything here is computed from REFERENCE §2-§4 inputs, independently of the solver.
 """
@@ -64,8 +65,10 @@ def moes_contact(m, l, lub, slide_to_roll=0.0, radius=0.02, t_in=363.15):
 def moes_central(m, l):
     """Moes' central film H_M (line contact, Barus, incompressible), coded independently here.
 
-    Transition exponent s = (7 + 8 exp(−2 H_EI/H_RI))/5 as in Venner & Lubrecht, Multilevel Methods in
-    Lubrication (2000). (REFERENCE §8 writes exp(−2 L M^−0.4); that variant differs by up to ~10 % at
+    Transition exponent s = (7 + 8 exp(−2 H_EI/H_RI))/5 as in Venner & Lubrecht, Multilevel Methods
+    in
+    Lubrication (2000). (REFERENCE §8 writes exp(−2 L M^−0.4); that variant differs by up to ~10 %
+    at
     L = 3 and is not the published form.)
     """
     h_ri, h_ei = 3.0 / m, 2.621 * m**-0.2

@@ -1,4 +1,5 @@
-"""Elastic deformation kernel against quadrature, DC-FFT against dense, and the Hertz line contact."""
+"""Elastic deformation kernel against quadrature, DC-FFT against dense, and the Hertz line
+contact."""
 
 import jax.numpy as jnp
 import numpy as np
@@ -31,8 +32,10 @@ def test_dc_fft_equals_dense(n):
 
 
 def test_hertz_pressure_gives_the_hertz_gap():
-    # P = √(1 − X²) (load π/2) must give a flat film inside |X| < 1 and, outside, the classical Hertz
-    # line-contact gap G(X) = ½[|X|√(X² − 1) − ln(|X| + √(X² − 1))] (K.L. Johnson, Contact Mechanics,
+    # P = √(1 − X²) (load π/2) must give a flat film inside |X| < 1 and, outside, the classical
+    # Hertz
+    # line-contact gap G(X) = ½[|X|√(X² − 1) − ln(|X| + √(X² − 1))] (K.L. Johnson, Contact
+    # Mechanics,
     # §5.6, in Hertz-scaled units). Error O(Δ) from piecewise-constant pressure cells.
     n = 1201
     x = np.linspace(-3.0, 3.0, n)

@@ -1,4 +1,5 @@
-"""The EHL solver on the paper's gear contacts: convergence, load balance, Hertz limit, squeeze, warm
+"""The EHL solver on the paper's gear contacts: convergence, load balance, Hertz limit, squeeze,
+warm
 starts, batching, retracing, robustness and bad input.
 
 Most tests share one model (``STANDARD``: 129 nodes, Roelands, Dowson-Higginson, the paper's Eyring
@@ -89,10 +90,12 @@ def test_high_load_pressure_tends_to_hertz():
 def test_squeeze_step_direction_and_magnitude(pitch_solution):
     """Load steps up by 20 % over one backward-Euler step Δt.
 
-    Expected: the film in the contact (mean of h over |x| < b) falls from the old steady value towards
+    Expected: the film in the contact (mean of h over |x| < b) falls from the old steady value
+    towards
     the new one; the squeeze term delays it, so the step lands in between, monotone in Δt. As Δt → 0
     the lubricant content ρh is frozen (mass conservation); as Δt → ∞ the step is the new steady
-    solution. In between, the film relaxes like ḣ = −(h − h_new)/τ with τ of the order of the time the
+    solution. In between, the film relaxes like ḣ = −(h − h_new)/τ with τ of the order of the time
+    the
     lubricant takes to cross the contact (a few b/um). (The central film alone is not monotone: the
     squeeze pressure is centre-peaked and dents the film, the entrapment effect.)
     """
@@ -118,7 +121,8 @@ def test_squeeze_step_direction_and_magnitude(pitch_solution):
     h = {k: mean(v) for k, v in steps.items()}
     # direction: between the old and the new steady films, monotone in Δt
     assert h_new < h[1e5] <= h[2.0] < h[0.5] < h[1e-5] < h_old
-    # Δt → 0: ρh frozen; what remains is the linear interpolation of the previous ρh onto this step's
+    # Δt → 0: ρh frozen; what remains is the linear interpolation of the previous ρh onto this
+    # step's
     # nodes (b grew by √1.2, 129 nodes): 5e-3. Δt → ∞: the steady solution.
     assert mean(steps[1e-5], "rho_h") == pytest.approx(mean(old, "rho_h"), rel=5e-3)
     assert h[1e5] == pytest.approx(h_new, rel=1e-4)

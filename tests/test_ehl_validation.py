@@ -52,7 +52,8 @@ def test_moes_central_film_full_range(m, l):
 
 def test_rolling_power_identity_incompressible_newtonian():
     """For a steady, incompressible, Newtonian film the Poiseuille dissipation equals the rolling
-    power: ∫ h³ p'²/(12η) dx = (u1 + u2) ∫ (h/2) p' dx (integrate −∫ q p' dx by parts, dq/dx = 0 where
+    power: ∫ h³ p'²/(12η) dx = (u1 + u2) ∫ (h/2) p' dx (integrate −∫ q p' dx by parts, dq/dx = 0
+    where
     p > 0, p = 0 elsewhere). The two sides use different outputs (power_loss_rolling and
     friction_rolling): the identity holds only if p satisfies Reynolds."""
     model = jg.EHLModel(n_nodes=257, **MOES_PHYSICS)
@@ -68,7 +69,8 @@ def test_rolling_power_identity_incompressible_newtonian():
     )
 
 
-# Pan-Hamrock: Roelands + Dowson-Higginson, pure rolling (η* = η), the paper's pair at the pitch point
+# Pan-Hamrock: Roelands + Dowson-Higginson, pure rolling (η* = η), the paper's pair at the pitch
+# point
 @pytest.mark.parametrize("torque, rpm", [(200.0, 500.0), (700.0, 2000.0), (700.0, 4200.0)])
 def test_pan_hamrock_moderate(torque, rpm):
     c = gear_contact(torque, rpm, slide_to_roll=0.0)

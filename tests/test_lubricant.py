@@ -18,7 +18,8 @@ def test_mil_l_23699_matches_reference_data():
     # Dynamic viscosity 6.0 mPa s at 90 °C and 13.3 at 60 °C (REFERENCE rounds to 2-3 digits: 1 %).
     assert float(lub.base_viscosity(363.15)) == pytest.approx(6.0e-3, rel=1e-2)
     assert float(lub.base_viscosity(333.15)) == pytest.approx(13.3e-3, rel=1e-2)
-    # α = 11.3 /GPa at 90 °C is an input; at 60 °C the published correlation α = 2.52e-8 η^0.156 gives
+    # α = 11.3 /GPa at 90 °C is an input; at 60 °C the published correlation α = 2.52e-8 η^0.156
+    # gives
     # 12.8 /GPa while the Roelands initial slope gives ~13.3: two models, agreeing within 5 %.
     assert float(lub.pressure_viscosity_coefficient(363.15)) == pytest.approx(11.3e-9, rel=1e-6)
     eta60 = float(lub.base_viscosity(333.15))
@@ -34,7 +35,8 @@ def test_iso_vg68_matches_reference_data():
     lub = jg.presets.iso_vg68()
     # Z ≈ 0.63 for α ≈ 22 /GPa at 40 °C (REFERENCE §4, 2 digits).
     assert float(lub.roelands_z) == pytest.approx(0.63, abs=6e-3)
-    # Walther reproduces 68 cSt at 40 °C by construction; check an independent point: ASTM D341 charts
+    # Walther reproduces 68 cSt at 40 °C by construction; check an independent point: ASTM D341
+    # charts
     # put a 68/8.7 cSt oil near 20 cSt at 70 °C (log-log interpolation by hand, 5 %).
     w1, w2 = np.log10(np.log10(68.7)), np.log10(np.log10(9.4))
     t1, t2, t = np.log10(313.15), np.log10(373.15), np.log10(343.15)

@@ -265,7 +265,8 @@ class _Inputs(eqx.Module):
 # Dimensionless problem
 # -------------------------------------------------------------------------------------------------
 def moes_central_film(m, l):
-    """Moes' central film H_M = (hc/R)(2U)^(−1/2) for given M, L (line contact, Barus, incompressible).
+    """Moes' central film H_M = (hc/R)(2U)^(−1/2) for given M, L (line contact, Barus,
+    incompressible).
 
     H_RI = 3/M, H_EI = 2.621 M^(−1/5), H_RP = 1.287 L^(2/3), H_EP = 1.311 M^(−1/8) L^(3/4),
     H_M = [(H_RI^(7/3) + H_EI^(7/3))^(3s/7) + (H_RP^(−7/2) + H_EP^(−7/2))^(−2s/7)]^(1/s) with
@@ -556,8 +557,10 @@ def _transfer(coarse: _Level, fine: _Level, u):
 
 
 def _schedules(model: EHLModel, dtype):
-    """Continuation schedules of the piezo-viscous exponent s, one row per cold attempt: four plateaus
-    1/4, 1/2, 3/4, 1 first (repeated values cost nothing: Newton stops at once when converged), then,
+    """Continuation schedules of the piezo-viscous exponent s, one row per cold attempt: four
+    plateaus
+    1/4, 1/2, 3/4, 1 first (repeated values cost nothing: Newton stops at once when converged),
+    then,
     if that failed, ``continuation_steps`` equal steps."""
     k = model.continuation_steps
     i = np.arange(1, k + 1)
@@ -565,8 +568,10 @@ def _schedules(model: EHLModel, dtype):
 
 
 def _cold_start(model: EHLModel, levels: list[_Level], svals):
-    """Continuation in the piezo-viscous exponent s (schedule ``svals``) on the coarsest grid, then grid
-    sequencing up to the second-finest grid; returns the fine-grid start and the iterations spent."""
+    """Continuation in the piezo-viscous exponent s (schedule ``svals``) on the coarsest grid, then
+    grid
+    sequencing up to the second-finest grid; returns the fine-grid start and the iterations
+    spent."""
     coarse = levels[0]
     u = _hertz_start(coarse)
     if len(levels) == 1:
@@ -615,7 +620,8 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
     fine = levels[-1]
     dtype = fine.x.dtype
     schedules = _schedules(model, dtype)
-    # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule; each runs only
+    # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule; each runs
+    # only
     # if everything before it failed (lax.cond: no work when skipped, outside vmap)
     n_cold = schedules.shape[0]
     kinds = jnp.asarray(([0] if warm else []) + list(range(1, n_cold + 1)))
@@ -644,7 +650,8 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
 
     init = (u_warm, jnp.asarray(jnp.inf, dtype=dtype), jnp.asarray(0), jnp.asarray(False))
     (u, res, it, ok), _ = jax.lax.scan(attempt, init, kinds)
-    # a closed (non-positive) film is not a smooth-EHL solution, however small the residual: report it
+    # a closed (non-positive) film is not a smooth-EHL solution, however small the residual: report
+    # it
     ok = ok & (jnp.min(fine.film(u)) > 0.0)
     finite = jnp.all(jnp.isfinite(u))
     fallback = _hertz_start(fine)

@@ -21,7 +21,6 @@ smoothing.
 
 from __future__ import annotations
 
-import jax
 import jax.numpy as jnp
 
 
@@ -33,7 +32,8 @@ def fischer_burmeister(a, b, smoothing):
 def smooth_positive(h, floor):
     """A smooth positive floor ½(h + √(h² + f²)): ≈ h for h ≫ f, f/2 at h = 0, f²/(4|h|) for h ≪ −f.
 
-    Written without cancellation on either side, so it is finite and positive with finite derivatives
+    Written without cancellation on either side, so it is finite and positive with finite
+    derivatives
     for any h (a gradient-safe double ``where``)."""
     r = jnp.sqrt(h * h + floor * floor)
     positive = h > 0.0
