@@ -246,3 +246,20 @@ def test_bad_model_and_arguments_raise():
         jg.solve_ehl(c, LUB, STANDARD, previous=object())
     with pytest.raises(ValueError, match="time_step"):
         jg.solve_ehl(c, LUB, STANDARD, previous=object(), time_step=-1.0)
+
+
+def test_float32_is_refused_with_a_clear_error():
+    # a fresh interpreter without x64: the solver must refuse rather than return float32 garbage
+    import subprocess
+    import sys
+
+    code = (
+        "import jaxgear as jg\n"
+        "c = jg.LineContact(reduced_radius=0.0128, load_per_width=5e5, u1=5.0, u2=4.0)\n"
+        "try:\n"
+        "    jg.solve_ehl(c, jg.presets.mil_l_23699())\n"
+        "except ValueError as e:\n"
+        "    print('ValueError:', e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert "ValueError" in out.stdout and "float64" in out.stdout, out.stdout + out.stderr

@@ -28,7 +28,6 @@ Outputs follow S. Li, Tribol. Int. 88 (2015): heat flux Eq. (12), damping Eq. (1
 from __future__ import annotations
 
 import functools
-import math
 
 import equinox as eqx
 import jax
@@ -207,6 +206,8 @@ class EHLSolution(eqx.Module):
         heat_flux, heat_flux_sliding, heat_flux_rolling: Q of paper Eq. (12) and its two parts,
         W/m².
         h_min, h_central: minimum and central (x = 0) film, m. h0: film offset, m. p_max: Pa.
+        (In the cavitated outlet the gap is partly filled: the shear terms are weighted by the fill
+        fraction q/(um ρ h), q the mass flux through x = 0, as in a JFO/Elrod streak model.)
         friction_sliding: Fs = ∫ η_s (u2 − u1)/h dx, N/m (paper Eq. 15, fluid part; sign of Eq. 15).
         friction_rolling: Fr = ∫ (h/2) ∂p/∂x dx, N/m (paper Eq. 15).
         damping: cm = ∫ η_s/h dx, N s/m² (paper Eq. 13 per unit width).
@@ -805,6 +806,11 @@ def solve_ehl(
         raise ValueError(f"lubricant = {type(lubricant).__name__} is not valid; valid: a Lubricant")
     n = model.n_nodes
     dtype = jnp.result_type(float)
+    if dtype != jnp.float64:
+        raise ValueError(
+            f"solve_ehl computes in {dtype}; EHL needs float64 (pressures ~1e9 Pa against films "
+            "~1e-8 m). Enable it with jax.config.update('jax_enable_x64', True) before use"
+        )
     if previous is not None:
         if time_step is None:
             raise ValueError(
@@ -839,5 +845,3 @@ def hertz_film_scale(contact: LineContact):
     """b²/R, m: the film thickness unit of the Hertz scaling H = h R/b²."""
     return contact.hertz_half_width**2 / contact.reduced_radius
 
-
-_ = math  # (kept for symbolic constants in future thermal terms)
