@@ -603,6 +603,12 @@ def _levels(model: EHLModel, inp: _Inputs):
     return sc, [_make_level(model, inp, sc, n, sizes[-1]) for n in sizes]
 
 
+def _fine_level(model: EHLModel, inp: _Inputs):
+    """Only the finest grid (no coarse influence matrices built)."""
+    sc = _scales(model, inp)
+    return sc, _make_level(model, inp, sc, model.n_nodes, model.n_nodes)
+
+
 def _warm_start(fine: _Level, init_x, init_p, init_h0):
     sc = fine.sc
     p = jnp.interp(fine.x * sc.b, init_x, init_p, left=0.0, right=0.0) / sc.ph
@@ -617,8 +623,7 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
 
     The fine-grid Newton loop appears once in the program: a warm solve is a scan over two attempts
     (the warm start, then, only if that failed, the cold start), so compile time does not double."""
-    sc, levels = _levels(model, inp)
-    fine = levels[-1]
+    sc, fine = _fine_level(model, inp)
     dtype = fine.x.dtype
     schedules = _schedules(model, dtype)
     # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule; each runs
@@ -633,6 +638,8 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
 
         def cold(_):
             row = jnp.clip(kind - 1, 0, n_cold - 1)
+            # the coarse grids are built here, inside the branch: a warm start never pays for them
+            _, levels = _levels(model, inp)
             return _cold_start(model, levels, schedules[row])
 
         def keep(_):
@@ -669,11 +676,9 @@ def _solve_core_jvp(model, warm, primals, tangents):
     u, res, it, ok = _solve_core(model, warm, inp, init_x, init_p, init_h0)
 
     def fine_residual(theta):
-        _, levels = _levels(model, theta)
-        return levels[-1].residual(u, 1.0)
+        return _fine_level(model, theta)[1].residual(u, 1.0)
 
-    _, levels = _levels(model, inp)
-    jac = levels[-1].jacobian(u, 1.0)
+    jac = _fine_level(model, inp)[1].jacobian(u, 1.0)
     _, df = jax.jvp(fine_residual, (inp,), (d_inp,))
     du = -jnp.linalg.solve(jac, df)
     z = jnp.zeros_like(res)
@@ -681,8 +686,7 @@ def _solve_core_jvp(model, warm, primals, tangents):
 
 
 def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
-    sc, levels = _levels(model, inp)
-    lev = levels[-1]
+    sc, lev = _fine_level(model, inp)
     c, lub = inp.contact, inp.lubricant
     n = lev.n
     r = c.reduced_radius
@@ -844,4 +848,3 @@ def _grid_positions(model: EHLModel, contact: LineContact, lubricant: Lubricant)
 def hertz_film_scale(contact: LineContact):
     """b²/R, m: the film thickness unit of the Hertz scaling H = h R/b²."""
     return contact.hertz_half_width**2 / contact.reduced_radius
-
