@@ -198,7 +198,7 @@ def write_results(
         "## EHL line-contact kernel (`benchmarks/ehl_kernel.py`)",
         "",
         f"Machine: {machine()}. Date: {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC.",
-        "Medians of 5 runs (3 for batches) after `block_until_ready`; compile = first call − median run.",
+        "Medians of 5 runs (3 for batches) after `block_until_ready`; compile = first call − median run.",  # noqa: E501
         "Contact: the paper's pair at the pitch point, 700 N m, 2000 rpm, SR 0.3, Mil-L-23699 at 90 °C "  # noqa: E501
         "(M ≈ 36, L ≈ 5.6); default physics (Roelands, Dowson-Higginson, paper Eyring η*). Warm: the "  # noqa: E501
         "neighbouring mesh position (load +3 %, R +2 %, speed +1 %) started from the cold solution.",  # noqa: E501
