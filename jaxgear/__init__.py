@@ -30,8 +30,13 @@ from .dynamics import dynamic_response_sweep as dynamic_response_sweep
 from .dynamics import mode_shapes as mode_shapes
 from .dynamics import natural_frequencies as natural_frequencies
 from .lubrication import thermal as thermal
+from .lubrication.ehl import EHLModel as EHLModel
+from .lubrication.ehl import EHLSolution as EHLSolution
+from .lubrication.ehl import LineContact as LineContact
+from .lubrication.ehl import solve_ehl as solve_ehl
 from .lubrication.friction_models import ConstantFriction as ConstantFriction
 from .lubrication.friction_models import FrictionModel as FrictionModel
 from .lubrication.friction_models import XuFriction as XuFriction
+from .lubrication.lubricant import Lubricant as Lubricant
 from .lubrication.roughness import Surfaces as Surfaces
 from .operating import OperatingPoint as OperatingPoint

@@ -5,6 +5,11 @@ from __future__ import annotations
 import math
 
 from .gear.pair import Bearings, GearPair, TipRelief
+from .lubrication.lubricant import iso_vg68 as iso_vg68
+from .lubrication.lubricant import mil_l_23699 as mil_l_23699
+from .lubrication.roughness import ground as ground
+from .lubrication.roughness import polished as polished
+from .lubrication.roughness import smooth as smooth
 from .material import steel as steel
 
 
@@ -32,10 +37,6 @@ def li2015_pair(tip_relief: float = 10e-6, relief_start_deg: float = 20.9) -> Ge
         ),
     )
 
-
-from .lubrication.roughness import ground as ground  # noqa: E402
-from .lubrication.roughness import polished as polished  # noqa: E402
-from .lubrication.roughness import smooth as smooth  # noqa: E402
 
 # Blanks of the calibrated preset (notebooks/calibration.ipynb): one mesh-coupled mode at 3500 rpm of
 # mesh excitation (2916.7 Hz), the other below the sweep at 400 rpm, with the mean mesh stiffness
