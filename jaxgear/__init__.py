@@ -26,3 +26,12 @@ from .lubrication.friction_models import ConstantFriction as ConstantFriction
 from .lubrication.friction_models import FrictionModel as FrictionModel
 from .lubrication.friction_models import XuFriction as XuFriction
 from .lubrication.roughness import Surfaces as Surfaces
+from .dynamics import DynamicResponse as DynamicResponse
+from .dynamics import DynamicsOptions as DynamicsOptions
+from .dynamics import MeshInterface as MeshInterface
+from .dynamics import Modes as Modes
+from .dynamics import dynamic_response as dynamic_response
+from .dynamics import dynamic_response_sweep as dynamic_response_sweep
+from .dynamics import mode_shapes as mode_shapes
+from .dynamics import natural_frequencies as natural_frequencies
+from .operating import OperatingPoint as OperatingPoint

@@ -1,0 +1,349 @@
+"""The 6-DOF spur gear dynamic model of paper Eq. (1) as a diffrax vector field.
+
+Degrees of freedom (per gear j = 1, 2): rotation θj, line-of-action (LOA) translation yj, off-line-of-action
+(OLOA) translation xj. The gears turn at the nominal speeds Ωj (Ω2 = Ω1 z1/z2) and the model works with
+the deviations φj = θj − Ωj t. Because r1Ω1 = r2Ω2 the nominal rotation adds nothing to the mesh
+deflection, and the torsional dampers ct act on the deviation speeds φj' (a damper on the absolute speed
+would be a constant drag of ct·Ω ≈ 3.7 kN m at 3500 rpm, far beyond the transmitted torque).
+
+Equations (paper Eq. 1; Fm = km(t)·δ(d) the mesh force, F1, F2 the total friction forces per pair):
+
+    J1 φ1'' + ct1 φ1' + r1 Fm = T1 + Σn F1n R1n
+    m1 y1'' + cy1 y1' + ky1 y1 + Fm = 0
+    m1 x1'' + cx1 x1' + kx1 x1 = −Σn F1n
+    J2 φ2'' + ct2 φ2' − r2 Fm = −T2 − Σn F2n R2n
+    m2 y2'' + cy2 y2' + ky2 y2 − Fm = 0
+    m2 x2'' + cx2 x2' + kx2 x2 = +Σn F2n
+
+with d = r1φ1 + y1 − r2φ2 − y2 − e(t) the mesh deflection relative to the excitation e(t) (the MeshCycle's
+``te_excitation``; paper Eq. 1's εs). Signs: F1 is the friction force on gear 1 along its surface velocity
+u1 = R1θ1' − x1' and −F2 the force on gear 2 along u2 = R2θ2' − x2' (paper Eqs. 3, 14-15). The paper
+prints +ΣF1 / −ΣF2 on the x equations, which with its own Eq. 3 would make friction do work of the wrong
+sign on xj; here the x equations carry the signs for which the friction power is exactly F1u1 − F2u2
+(shown by the energy-balance test). Equivalently, x is positive against the surface motion.
+
+The EHL mesh damping cm per pair acts along the OLOA direction (the common tangent, the direction of
+sliding), not along the LOA: it adds f_dn = −cmn·v_sn to both F1n and F2n (paper Eq. 14-15), where
+v_sn = (R1n φ1' − x1') − (R2n φ2' − x2') is the vibratory part of the sliding velocity. The nominal part
+cm·us is the viscous sliding friction Fs itself, which the EHL already puts in the friction tables.
+
+Load torque: T2 = T1 (r2/r1)(1 + s) with s solved together with the periodic orbit so that the mean speed
+of both gears is exactly nominal (mean moment balance including the friction moments and damping): the
+rigid-body rotation, free in Eq. 1, neither drifts nor needs an arbitrary spring.
+
+Backlash (clearance 2ℓ along the LOA): the rotation origin is the drive-flank touching position, so the
+tooth-contact function is δ(d + ℓ) with δ(x) = x − ℓ (x > ℓ, drive-side contact), 0 (|x| ≤ ℓ,
+separation), x + ℓ (x < −ℓ, back-side contact). In static equilibrium εd = r1φ1 + y1 − r2φ2 − y2 then equals
+the loaded static TE. ``backlash="smooth"`` replaces the kinks by softplus corners of width w.
+
+Tables (km, e and the mesh-interface sums) are interpolated in time by periodic cubic splines (C²), so the
+right-hand side is smooth between the M table points. The spline interpolates the data as given: a jump
+in the data (a tooth pair entering with load) is reproduced with the usual local spline overshoot.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jaxtyping import Array, Float
+
+from .._validation import check_non_negative, check_positive
+
+BacklashKind = Literal["exact", "smooth"]
+BACKLASH_KINDS = ("exact", "smooth")
+
+#: Length scale of the dimensionless state (positions in µm).
+LENGTH_SCALE = 1e-6
+
+
+class MeshInterface(eqx.Module):
+    """The lubricated mesh interface seen by the dynamics, per mesh position and tooth-pair slot.
+
+    Tables over the same M positions (and pair slots) as the ``MeshCycle``; zero by default (dry,
+    frictionless, undamped mesh). The tribo-dynamic model updates them from the EHL solutions.
+
+    Attributes:
+        damping: EHL mesh damping cm per pair, N s/m, shape [M, 2], ≥ 0 (paper Eq. 13).
+        friction_1: friction force F1 on gear 1 per pair, N, [M, 2] (paper Eq. 14, without the cm term,
+            which the dynamics adds from the vibratory sliding velocity): positive along gear 1's surface
+            velocity.
+        friction_2: F2 per pair, N, [M, 2] (paper Eq. 15, without the cm term): gear 2 receives −F2 along
+            its surface velocity.
+    """
+
+    damping: Float[Array, "M 2"] = eqx.field(converter=jnp.asarray)
+    friction_1: Float[Array, "M 2"] = eqx.field(converter=jnp.asarray)
+    friction_2: Float[Array, "M 2"] = eqx.field(converter=jnp.asarray)
+
+    def __check_init__(self):
+        for name in ("damping", "friction_1", "friction_2"):
+            shape = getattr(self, name).shape
+            if len(shape) != 2 or shape[1] != 2:
+                raise ValueError(f"MeshInterface.{name} must have shape [M, 2]; got {shape}")
+        if not self.damping.shape == self.friction_1.shape == self.friction_2.shape:
+            raise ValueError("MeshInterface tables must share one shape [M, 2]")
+        check_non_negative("MeshInterface.damping", self.damping, "N s/m")
+
+    @classmethod
+    def zeros(cls, n_positions: int) -> MeshInterface:
+        """A dry, frictionless, undamped interface over ``n_positions`` mesh positions."""
+        z = jnp.zeros((n_positions, 2))
+        return cls(damping=z, friction_1=z, friction_2=z)
+
+    @property
+    def n_positions(self) -> int:
+        return self.damping.shape[0]
+
+
+class DynamicsOptions(eqx.Module):
+    """Numerical choices of the dynamic model (static ones fix shapes and control flow).
+
+    Attributes:
+        backlash: "exact" (piecewise linear) or "smooth" (softplus corners; use it for gradients through
+            contact loss). Static.
+        backlash_width: corner width w of the smooth backlash, m (default 0.1 µm, 0.3 % of the static
+            mesh deflection of the paper's pair at 700 N m).
+        steps_per_period: fixed steps of the Runge-Kutta solver per mesh period. Static. The default 128
+            Tsit5 steps keep the DTE RMS within 1e-6 relative of a 4× finer solve over 500-4200 rpm
+            (benchmarks/dynamics.py prints the check).
+        newton_max_steps: Newton iterations on the periodicity condition for one speed. Static.
+        newton_batch_steps: iterations for a whole batch of speeds together; members not converged
+            by then are redone one at a time (transient decay, then ``newton_max_steps``). Static.
+        newton_tol: convergence tolerance on the scaled periodicity residual (dimensionless, relative to
+            the state's magnitude).
+        solver: a diffrax Runge-Kutta solver (static structure), default Tsit5.
+        transient_periods: mesh periods integrated to let transients decay before a second Newton
+            attempt when the first fails or finds an unstable orbit. Static.
+        n_positions: positions M of the mesh cycle built when none is passed. Static.
+    """
+
+    backlash: str = eqx.field(static=True, default="exact")
+    backlash_width: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1e-7)
+    steps_per_period: int = eqx.field(static=True, default=128)
+    newton_max_steps: int = eqx.field(static=True, default=30)
+    newton_batch_steps: int = eqx.field(static=True, default=8)
+    newton_tol: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1e-9)
+    solver: object = eqx.field(static=True, default=None)
+    transient_periods: int = eqx.field(static=True, default=60)
+    n_positions: int = eqx.field(static=True, default=64)
+
+    def __check_init__(self):
+        if self.backlash not in BACKLASH_KINDS:
+            raise ValueError(
+                f"DynamicsOptions.backlash = {self.backlash!r} is not valid; valid choices: "
+                + ", ".join(map(repr, BACKLASH_KINDS))
+            )
+        check_positive("DynamicsOptions.backlash_width", self.backlash_width, "m")
+        check_positive("DynamicsOptions.newton_tol", self.newton_tol)
+        if int(self.steps_per_period) < 8:
+            raise ValueError(
+                f"DynamicsOptions.steps_per_period = {self.steps_per_period} is out of range; "
+                "valid range: [8, inf)"
+            )
+        if int(self.newton_max_steps) < 1:
+            raise ValueError(
+                f"DynamicsOptions.newton_max_steps = {self.newton_max_steps} is out of range; "
+                "valid range: [1, inf)"
+            )
+
+
+def backlash_exact(x, half_clearance):
+    """Piecewise backlash δ(x): x − ℓ above ℓ, 0 inside ±ℓ, x + ℓ below −ℓ (m)."""
+    return jnp.where(x > half_clearance, x - half_clearance, 0.0) + jnp.where(
+        x < -half_clearance, x + half_clearance, 0.0
+    )
+
+
+def backlash_smooth(x, half_clearance, width):
+    """Softplus backlash: w·[softplus((x − ℓ)/w) − softplus((−x − ℓ)/w)] (m); → exact as w → 0.
+
+    Differs from the exact δ by at most w·ln 2 (at the corners) and by w·exp(−|x ∓ ℓ|/w) away from them.
+    """
+    return width * (
+        jax.nn.softplus((x - half_clearance) / width)
+        - jax.nn.softplus((-x - half_clearance) / width)
+    )
+
+
+def backlash_potential_exact(x, half_clearance):
+    """P(x) with P' = δ (exact backlash): ½δ(x)², m²."""
+    return 0.5 * backlash_exact(x, half_clearance) ** 2
+
+
+class PeriodicSpline(eqx.Module):
+    """Periodic cubic spline (C²) through samples y_i at τ_i = i/M of the unit period, several channels.
+
+    The second derivatives solve the circulant system M_{i−1} + 4M_i + M_{i+1} = 6(y_{i+1} − 2y_i +
+    y_{i−1})/h², diagonalised by the FFT.
+    """
+
+    values: Float[Array, "M C"]
+    second: Float[Array, "M C"]
+
+    def __init__(self, values):
+        values = jnp.asarray(values)
+        m = values.shape[0]
+        k = jnp.arange(m)
+        c = jnp.cos(2.0 * jnp.pi * k / m)
+        gain = 6.0 * m**2 * (2.0 * c - 2.0) / (4.0 + 2.0 * c)
+        spectrum = jnp.fft.fft(values, axis=0) * gain[:, None]
+        self.values = values
+        self.second = jnp.real(jnp.fft.ifft(spectrum, axis=0))
+
+    def __call__(self, tau):
+        m = self.values.shape[0]
+        u = (tau - jnp.floor(tau)) * m
+        i = jnp.clip(jnp.floor(u).astype(jnp.int32), 0, m - 1)
+        s = u - i
+        j = (i + 1) % m
+        h2 = 1.0 / m**2
+        a = 1.0 - s
+        return (
+            a * self.values[i]
+            + s * self.values[j]
+            + h2 / 6.0 * ((a**3 - a) * self.second[i] + (s**3 - s) * self.second[j])
+        )
+
+
+# Channels of the interpolated table.
+_KM, _E, _F1, _F1R, _F2, _F2R, _C0, _C1, _C2, _C11, _C12, _C22 = range(12)
+
+
+def interface_channels(mesh, interface: MeshInterface) -> Float[Array, "M 12"]:
+    """km, e and the per-pair sums of the interface the equations of motion need, per position."""
+    r1 = mesh.radius_of_curvature[:, :, 0]
+    r2 = mesh.radius_of_curvature[:, :, 1]
+    cm = interface.damping
+    f1 = interface.friction_1
+    f2 = interface.friction_2
+    cols = [
+        mesh.mesh_stiffness,
+        mesh.te_excitation,
+        f1.sum(1),
+        (f1 * r1).sum(1),
+        f2.sum(1),
+        (f2 * r2).sum(1),
+        cm.sum(1),
+        (cm * r1).sum(1),
+        (cm * r2).sum(1),
+        (cm * r1 * r1).sum(1),
+        (cm * r1 * r2).sum(1),
+        (cm * r2 * r2).sum(1),
+    ]
+    return jnp.stack(cols, axis=1)
+
+
+class GearDynamics(eqx.Module):
+    """Parameters of Eq. (1) at one operating point; ``__call__(τ, z, s)`` is the diffrax vector field.
+
+    Time is the mesh-cycle fraction τ = t/Tm; the state is z = [q/L, (dq/dτ)/L] with
+    q = [r1φ1, y1, x1, r2φ2, y2, x2] (m) and L = 1 µm; s is the load-torque correction (T2 = T1 r2/r1 (1+s)).
+    """
+
+    base_radius: Float[Array, "2"]
+    inertia: Float[Array, "2"]
+    mass: Float[Array, "2"]
+    ky: Float[Array, "2"]
+    cy: Float[Array, "2"]
+    kx: Float[Array, "2"]
+    cx: Float[Array, "2"]
+    ct: Float[Array, "2"]
+    half_clearance: Float[Array, ""]
+    torque: Float[Array, ""]
+    mesh_period: Float[Array, ""]
+    omega: Float[Array, "2"]
+    tables: PeriodicSpline
+    backlash_width: Float[Array, ""]
+    backlash: str = eqx.field(static=True)
+
+    @property
+    def equivalent_mass(self) -> Float[Array, "2"]:
+        """J/r², kg: the rotations' inertia seen along the LOA."""
+        return self.inertia / self.base_radius**2
+
+    def contact(self, x):
+        """δ(x) of the chosen backlash model (m)."""
+        if self.backlash == "exact":
+            return backlash_exact(x, self.half_clearance)
+        return backlash_smooth(x, self.half_clearance, self.backlash_width)
+
+    def load_torque(self, s):
+        """T2 (N m) for the correction s."""
+        return self.torque * self.base_radius[1] / self.base_radius[0] * (1.0 + s)
+
+    def physical(self, z):
+        """(q [m], dq/dt [m/s]) from the scaled state z[..., 12]."""
+        q = z[..., :6] * LENGTH_SCALE
+        v = z[..., 6:] * (LENGTH_SCALE / self.mesh_period)
+        return q, v
+
+    def mesh_deflection(self, q, e):
+        """d = r1φ1 + y1 − r2φ2 − y2 − e (m), the argument of δ(d + ℓ)."""
+        return q[..., 0] + q[..., 1] - q[..., 3] - q[..., 4] - e
+
+    def accelerations(self, tau, q, v, s):
+        """d²q/dt² (m/s²) of paper Eq. (1) at time fraction τ."""
+        tab = self.tables(tau)
+        rb = self.base_radius
+        dphi1 = v[0] / rb[0]
+        dphi2 = v[3] / rb[1]
+        d = self.mesh_deflection(q, tab[_E])
+        fm = tab[_KM] * self.contact(d + self.half_clearance)
+        # OLOA mesh damping on the vibratory sliding velocity (module docstring).
+        dx1, dx2 = v[2], v[5]
+        fd = -(tab[_C1] * dphi1 - tab[_C0] * dx1 - tab[_C2] * dphi2 + tab[_C0] * dx2)
+        fd_r1 = -(tab[_C11] * dphi1 - tab[_C1] * dx1 - tab[_C12] * dphi2 + tab[_C1] * dx2)
+        fd_r2 = -(tab[_C12] * dphi1 - tab[_C2] * dx1 - tab[_C22] * dphi2 + tab[_C2] * dx2)
+        t1 = self.torque
+        t2 = self.load_torque(s)
+        m, j = self.mass, self.inertia
+        ddphi1 = (t1 + tab[_F1R] + fd_r1 - self.ct[0] * dphi1 - rb[0] * fm) / j[0]
+        ddy1 = (-self.cy[0] * v[1] - self.ky[0] * q[1] - fm) / m[0]
+        ddx1 = (-self.cx[0] * v[2] - self.kx[0] * q[2] - (tab[_F1] + fd)) / m[0]
+        ddphi2 = (-t2 - tab[_F2R] - fd_r2 - self.ct[1] * dphi2 + rb[1] * fm) / j[1]
+        ddy2 = (-self.cy[1] * v[4] - self.ky[1] * q[4] + fm) / m[1]
+        ddx2 = (-self.cx[1] * v[5] - self.kx[1] * q[5] + (tab[_F2] + fd)) / m[1]
+        return jnp.stack([rb[0] * ddphi1, ddy1, ddx1, rb[1] * ddphi2, ddy2, ddx2])
+
+    def __call__(self, tau, z, s):
+        q, v = self.physical(z)
+        a = self.accelerations(tau, q, v, s)
+        return jnp.concatenate([z[6:], a * (self.mesh_period**2 / LENGTH_SCALE)])
+
+
+def build_dynamics(
+    pair, op, mesh, interface: MeshInterface, options: DynamicsOptions
+) -> GearDynamics:
+    """Assemble Eq. (1)'s parameters from the gear pair, operating point, mesh cycle and interface."""
+    from ..gear.geometry import gear_geometry
+
+    if interface.n_positions != mesh.n_positions:
+        raise ValueError(
+            f"MeshInterface has {interface.n_positions} positions but the MeshCycle has "
+            f"{mesh.n_positions}; they must match"
+        )
+    geo = gear_geometry(pair)
+    rb = geo.base_radius
+    z1, z2 = pair.teeth
+    omega1 = op.speed_rpm * (2.0 * jnp.pi / 60.0)
+    b = pair.bearings
+    return GearDynamics(
+        base_radius=rb,
+        inertia=pair.blank_inertia,
+        mass=pair.blank_mass,
+        ky=b.ky,
+        cy=b.cy,
+        kx=b.kx,
+        cx=b.cx,
+        ct=b.ct,
+        half_clearance=0.5 * pair.backlash,
+        torque=op.torque,
+        mesh_period=2.0 * jnp.pi / (z1 * omega1),
+        omega=jnp.stack([omega1, omega1 * z1 / z2]),
+        tables=PeriodicSpline(interface_channels(mesh, interface)),
+        backlash_width=options.backlash_width,
+        backlash=options.backlash,
+    )

@@ -1,0 +1,539 @@
+"""Periodic steady-state response of the 6-DOF gear model over one mesh cycle, DTE and speed sweeps.
+
+The steady state is found by shooting: Newton on the periodicity of the Poincaré map over one mesh
+period (a fixed-step diffrax solve, differentiated forward with ``jax.jacfwd``), with the load-torque
+correction s as a 13th unknown and a gauge on the free rigid-body rotation as the 13th equation:
+
+    R(z0, s) = [ z(Tm; z0, s) − z0 ,  r1φ1(0) + r2φ2(0) ] = 0.
+
+Periodicity of the rotations themselves (not only of their speeds) makes the mean speed exactly nominal,
+so s is the mean moment balance including friction and damping. Gradients of anything computed from the
+orbit use the implicit function theorem on R = 0 (``lax.custom_root``), never the Newton iterations.
+"""
+
+from __future__ import annotations
+
+import diffrax
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jaxtyping import Array, Bool, Float, Int
+
+from .._validation import check_positive, is_concrete
+from ..operating import OperatingPoint
+from .model import (
+    LENGTH_SCALE,
+    DynamicsOptions,
+    GearDynamics,
+    MeshInterface,
+    build_dynamics,
+)
+
+#: Mesh harmonics in the DTE RMS (REFERENCE §7 R1).
+N_HARMONICS = 10
+
+STATUS_CONVERGED = 0
+STATUS_NOT_CONVERGED = 1
+STATUS_NOT_FINITE = 2
+STATUS_UNSTABLE = 3
+
+#: Floquet multipliers up to 1 + this count as stable (the free rigid rotation has exactly 1).
+STABILITY_TOL = 1e-6
+
+
+class DynamicResponse(eqx.Module):
+    """Periodic steady state over one mesh cycle, at the M positions of the mesh cycle (τ_i = i/M).
+
+    Attributes (SI; leading batch axis in sweeps):
+        speed_rpm: gear 1 speed, rpm. torque: T1, N m. load_torque: T2 from the mean moment balance, N m.
+        mesh_fraction: τ_i [M]. time: t_i = τ_i Tm, s [M].
+        displacement: [M, 6] deviations (φ1 rad, y1 m, x1 m, φ2 rad, y2 m, x2 m) from nominal rotation.
+        velocity: [M, 6] their time derivatives (rad/s, m/s).
+        dynamic_te: εd = r1φ1 + y1 − r2φ2 − y2 (m) [M] (equals the static TE in static equilibrium).
+        mesh_force: km δ (N) [M].
+        tooth_force: dynamic tooth force per pair W_T = W_sT (r1/T1) km δ (paper Eq. 2), N [M, 2].
+        surface_velocity: uj = Rj(Ωj + φj') − xj' per [position, pair, gear] (paper Eq. 3), m/s [M, 2, 2].
+        contact_loss: 1.0 where the drive flanks separate (δ ≤ 0) [M]; back_contact: 1.0 on the back side.
+        contact_lost: any contact loss over the cycle.
+        dte_harmonics: amplitudes εd,q of mesh harmonics q = 1..10, m [10].
+        dte_rms: √(Σq εd,q²), m (REFERENCE §7 R1).
+        converged: Newton met ``newton_tol``; stable: all Floquet multipliers |μ| ≤ 1 + 1e-6 (an
+        unstable periodic orbit is a solution that the real gears would leave);
+        floquet_multiplier: the largest |μ|; status: 0 converged and stable, 1 Newton did not
+        converge, 2 not finite, 3 converged to an unstable orbit; newton_iterations,
+        periodicity_residual: max |z(Tm) − z(0)| / max |z| of the returned orbit (dimensionless).
+        initial_state: the shooting unknowns [13] (scaled state at τ = 0 and s), reusable as a guess.
+    """
+
+    speed_rpm: Float[Array, ""]
+    torque: Float[Array, ""]
+    load_torque: Float[Array, ""]
+    mesh_fraction: Float[Array, " M"]
+    time: Float[Array, " M"]
+    displacement: Float[Array, "M 6"]
+    velocity: Float[Array, "M 6"]
+    dynamic_te: Float[Array, " M"]
+    mesh_force: Float[Array, " M"]
+    tooth_force: Float[Array, "M 2"]
+    surface_velocity: Float[Array, "M 2 2"]
+    contact_loss: Float[Array, " M"]
+    back_contact: Float[Array, " M"]
+    contact_lost: Bool[Array, ""]
+    dte_harmonics: Float[Array, " 10"]
+    dte_rms: Float[Array, ""]
+    converged: Bool[Array, ""]
+    stable: Bool[Array, ""]
+    floquet_multiplier: Float[Array, ""]
+    status: Int[Array, ""]
+    newton_iterations: Int[Array, ""]
+    periodicity_residual: Float[Array, ""]
+    initial_state: Float[Array, " 13"]
+
+
+def _solver(options: DynamicsOptions):
+    return diffrax.Tsit5() if options.solver is None else options.solver
+
+
+def _integrate(dyn: GearDynamics, z0, s, options: DynamicsOptions, ts=None):
+    """One mesh period from z0; returns z(1) or z at the fractions ``ts``."""
+    n = options.steps_per_period
+    saveat = diffrax.SaveAt(t1=True) if ts is None else diffrax.SaveAt(ts=ts)
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(dyn),
+        _solver(options),
+        t0=0.0,
+        t1=1.0,
+        dt0=1.0 / n,
+        y0=z0,
+        args=s,
+        stepsize_controller=diffrax.ConstantStepSize(),
+        saveat=saveat,
+        max_steps=n + 2,
+        adjoint=diffrax.ForwardMode(),
+    )
+    return sol.ys[-1] if ts is None else sol.ys
+
+
+def _residual(dyn: GearDynamics, w, options: DynamicsOptions):
+    """R(w) = [z(Tm) − z0, r1φ1(0) + r2φ2(0)] (scaled), w = [z0, s]."""
+    z0, s = w[:12], w[12]
+    z1 = _integrate(dyn, z0, s, options)
+    return jnp.concatenate([z1 - z0, (z0[0] + z0[3])[None]])
+
+
+def static_guess(dyn: GearDynamics) -> Float[Array, " 13"]:
+    """Shooting unknowns of the static equilibrium at τ = 0 (frictionless, in contact, at rest)."""
+    tab = dyn.tables(0.0)
+    km, e = tab[0], tab[1]
+    force = dyn.torque / dyn.base_radius[0]
+    y1 = -force / dyn.ky[0]
+    y2 = force / dyn.ky[1]
+    rel = e + force / km - y1 + y2  # r1φ1 − r2φ2 with the mesh deflection at F/km
+    q = jnp.stack([0.5 * rel, y1, 0.0, -0.5 * rel, y2, 0.0]) / LENGTH_SCALE
+    return jnp.concatenate([q, jnp.zeros(6), jnp.zeros(1)])
+
+
+def _scaled_norm(r, w):
+    return jnp.max(jnp.abs(r), axis=-1) / (1.0 + jnp.max(jnp.abs(w[..., :12]), axis=-1))
+
+
+def _batch_solve_newton(dyns, w0, options: DynamicsOptions, max_steps: int):
+    """Periodic orbits of a batch of systems (leading axis B of ``dyns`` and ``w0`` [B, 13]).
+
+    Newton-Broyden with lazy backtracking: the exact Jacobian (``jacfwd`` through one period, 14
+    tangent lanes) is computed at the start, refreshed for the whole batch only when some member
+    stalls (two rejected trial points in a row), and updated by Broyden's rank-one rule otherwise, so
+    most iterations cost one plain period. Linear cases converge in one exact Newton step.
+    A trial point whose residual does not fall below the last accepted one is rejected and the step
+    halved. The loop is batch-aware (scalar predicates), so it is not recomputed per member under vmap.
+
+    Returns (w [B, 13], (iterations [B], scaled residual [B], converged [B], max |Floquet| [B])).
+    """
+    res = jax.vmap(lambda d, w: _residual(d, w, options))
+    jac = jax.vmap(jax.jacfwd(lambda d, w: _residual(d, w, options), argnums=1))
+    n = w0.shape[-1]
+    eye = jnp.eye(n)
+    tol = options.newton_tol
+    r0 = res(dyns, w0)
+    rn0 = jnp.where(jnp.all(jnp.isfinite(r0), -1), _scaled_norm(r0, w0), jnp.inf)
+    j0 = jac(dyns, w0)
+    bsz = w0.shape[0]
+
+    def cond(c):
+        i, active = c[-2], c[-1]
+        return jnp.any(active) & (i < max_steps)
+
+    def body(c):
+        w, r, rn, jm, lam, fails, iters, i, active = c
+        jm_safe = jnp.where(jnp.all(jnp.isfinite(jm), (-2, -1))[:, None, None], jm, eye)
+        step = jnp.linalg.solve(jm_safe, -r[..., None])[..., 0]
+        w_try = w + lam[:, None] * step
+        r_try = res(dyns, w_try)
+        finite = jnp.all(jnp.isfinite(r_try), -1)
+        rn_try = jnp.where(finite, _scaled_norm(r_try, w_try), jnp.inf)
+        accept = active & (rn_try < rn)
+        # Broyden's (good) rank-one update on accepted members.
+        dw = w_try - w
+        dr = r_try - r
+        denom = jnp.sum(dw * dw, -1)
+        upd = (
+            jnp.einsum("bi,bj->bij", dr - jnp.einsum("bij,bj->bi", jm, dw), dw)
+            / jnp.where(denom > 0, denom, 1.0)[:, None, None]
+        )
+        jm = jnp.where(accept[:, None, None] & (denom > 0)[:, None, None], jm + upd, jm)
+        w = jnp.where(accept[:, None], w_try, w)
+        r = jnp.where(accept[:, None], r_try, r)
+        rn = jnp.where(accept, rn_try, rn)
+        iters = iters + active.astype(iters.dtype)
+        lam = jnp.where(accept, 1.0, jnp.where(active, 0.5 * lam, lam))
+        fails = jnp.where(accept, 0, fails + active.astype(fails.dtype))
+        done = rn <= tol
+        stuck = lam < 1e-4
+        active = active & ~done & ~stuck
+        # Refresh the exact Jacobian (whole batch, scalar predicate) when a member stalls.
+        refresh = jnp.any(active & (fails >= 2))
+        jm = jax.lax.cond(refresh, lambda: jac(dyns, w), lambda: jm)
+        lam = jnp.where(refresh & active, 1.0, lam)
+        fails = jnp.where(refresh, 0, fails)
+        return w, r, rn, jm, lam, fails, iters, i + 1, active
+
+    init = (
+        w0,
+        r0,
+        rn0,
+        j0,
+        jnp.ones(bsz, w0.dtype),
+        jnp.zeros(bsz, jnp.int32),
+        jnp.ones(bsz, jnp.int32),
+        jnp.asarray(0),
+        rn0 > tol,
+    )
+    w, _, rn, _, _, _, iters, _, _ = jax.lax.while_loop(cond, body, init)
+    done = rn <= tol
+    # Monodromy matrix = ∂z(Tm)/∂z0 = J[:12, :12] + I at the orbit; the free rigid rotation gives 1.
+    mono = jac(dyns, w)[:, :12, :12] + jnp.eye(12)
+    floquet = jnp.max(jnp.abs(jnp.linalg.eigvals(mono)), axis=-1)
+    return w, (iters, rn, done, floquet)
+
+
+def _transient(dyn: GearDynamics, w, options: DynamicsOptions):
+    """Integrate ``options.transient_periods`` mesh periods from w (transients decay), re-gauged."""
+    n = options.transient_periods
+    steps = options.steps_per_period * n
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(dyn),
+        _solver(options),
+        t0=0.0,
+        t1=float(n),
+        dt0=1.0 / options.steps_per_period,
+        y0=w[:12],
+        args=w[12],
+        stepsize_controller=diffrax.ConstantStepSize(),
+        saveat=diffrax.SaveAt(t1=True),
+        max_steps=steps + 2,
+        adjoint=diffrax.ForwardMode(),
+    )
+    z = sol.ys[-1]
+    rigid = 0.5 * (z[0] + z[3])
+    z = z.at[0].add(-rigid).at[3].add(-rigid)
+    return jnp.concatenate([z, w[12:]])
+
+
+def _acceptable(aux):
+    _, _, done, floquet = aux
+    return done & (floquet <= 1.0 + STABILITY_TOL)
+
+
+def _index(tree, i):
+    return jax.tree_util.tree_map(lambda a: a[i], tree)
+
+
+def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None):
+    """Batched periodic orbits with a per-member fallback and implicit differentiation.
+
+    Members whose Newton fails or ends on an unstable orbit are redone one at a time (a loop with a
+    scalar ``lax.cond``, so it costs nothing when unused): transients are let decay from
+    ``fallback_from`` (default ``w0``) for ``options.transient_periods`` periods, then Newton again.
+    The result is then passed through ``lax.custom_root`` per member, so derivatives come from the
+    implicit function theorem on R = 0 and never from the iterations.
+    """
+    dyns_c = jax.lax.stop_gradient(dyns)
+    w, aux = _batch_solve_newton(
+        dyns_c,
+        jax.lax.stop_gradient(w0),
+        options,
+        min(options.newton_batch_steps, options.newton_max_steps),
+    )
+    start = w0 if fallback_from is None else fallback_from
+    start = jax.lax.stop_gradient(start)
+
+    def redo(i, carry):
+        w, aux = carry
+        ok = _acceptable(_index(aux, i))
+
+        def again():
+            dyn_i = _index(dyns_c, i)
+            w_t = _transient(dyn_i, start[i], options)
+            dyn_1 = jax.tree_util.tree_map(lambda a: a[None], dyn_i)
+            w1, aux1 = _batch_solve_newton(dyn_1, w_t[None], options, options.newton_max_steps)
+            # keep the new attempt only if it is better (acceptable, or at least converged)
+            better = _acceptable(_index(aux1, 0)) | (aux1[2][0] & ~aux[2][i])
+            w_new = jnp.where(better, w1[0], w[i])
+            aux_new = jax.tree_util.tree_map(
+                lambda a, b: a.at[i].set(jnp.where(better, b[0], a[i])), aux, aux1
+            )
+            return w.at[i].set(w_new), aux_new
+
+        return jax.lax.cond(ok, lambda: (w, aux), again)
+
+    w, aux = jax.lax.fori_loop(0, w.shape[0], redo, (w, aux))
+
+    def attach(dyn, w_star):
+        def identity_solve(f, x):
+            return x
+
+        def tangent_solve(g, y):
+            return jnp.linalg.solve(jax.jacfwd(g)(y), y)
+
+        return jax.lax.custom_root(
+            lambda w: _residual(dyn, w, options), w_star, identity_solve, tangent_solve
+        )
+
+    w = jax.vmap(attach)(dyns, w)
+    return w, aux
+
+
+def _safe_abs_complex(c):
+    mag2 = jnp.real(c) ** 2 + jnp.imag(c) ** 2
+    ok = mag2 > 0.0
+    return jnp.where(ok, jnp.sqrt(jnp.where(ok, mag2, 1.0)), 0.0)
+
+
+def dte_harmonic_amplitudes(dte, n_harmonics: int = N_HARMONICS):
+    """Amplitudes (m) of mesh harmonics 1..n of one period of εd sampled at M uniform points."""
+    m = dte.shape[-1]
+    if m < 2 * n_harmonics + 1:
+        raise ValueError(f"need at least {2 * n_harmonics + 1} samples per period; got {m}")
+    c = jnp.fft.rfft(dte, axis=-1) / m
+    return 2.0 * _safe_abs_complex(c[..., 1 : n_harmonics + 1])
+
+
+def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) -> DynamicResponse:
+    iters, _, newton_ok, floquet = aux
+    m = mesh.n_positions
+    ts = jnp.arange(m + 1) / m
+    zs = _integrate(dyn, w[:12], w[12], options, ts=ts)
+    resid = jnp.max(jnp.abs(zs[-1] - zs[0])) / jnp.maximum(jnp.max(jnp.abs(zs)), 1e-30)
+    q, v = dyn.physical(zs[:-1])
+    rb = dyn.base_radius
+    rot_scale = jnp.stack([1 / rb[0], 1.0, 1.0, 1 / rb[1], 1.0, 1.0])
+    displacement = q * rot_scale
+    velocity = v * rot_scale
+    dte = q[:, 0] + q[:, 1] - q[:, 3] - q[:, 4]
+    km = mesh.mesh_stiffness
+    d = dte - mesh.te_excitation
+    fm = km * dyn.contact(d + dyn.half_clearance)
+    tooth = mesh.normal_load / mesh.total_load * fm[:, None]
+    arms = mesh.radius_of_curvature  # [M, pair, gear]
+    speed = dyn.omega[None, :] + velocity[:, jnp.array([0, 3])]  # θj' [M, gear]
+    dx = velocity[:, jnp.array([2, 5])]  # xj' [M, gear]
+    surf = arms * speed[:, None, :] - dx[:, None, :]
+    harm = dte_harmonic_amplitudes(dte)
+    rms = jnp.sqrt(jnp.sum(harm**2))
+    finite = jnp.all(jnp.isfinite(zs)) & jnp.isfinite(rms)
+    converged = newton_ok & finite
+    stable = floquet <= 1.0 + STABILITY_TOL
+    status = jnp.where(
+        finite,
+        jnp.where(
+            converged, jnp.where(stable, STATUS_CONVERGED, STATUS_UNSTABLE), STATUS_NOT_CONVERGED
+        ),
+        STATUS_NOT_FINITE,
+    )
+    return DynamicResponse(
+        speed_rpm=jnp.asarray(op.speed_rpm, float),
+        torque=jnp.asarray(op.torque, float),
+        load_torque=dyn.load_torque(w[12]),
+        mesh_fraction=ts[:-1],
+        time=ts[:-1] * dyn.mesh_period,
+        displacement=displacement,
+        velocity=velocity,
+        dynamic_te=dte,
+        mesh_force=fm,
+        tooth_force=tooth,
+        surface_velocity=surf,
+        contact_loss=(d < 0.0).astype(float),
+        back_contact=(d < -2.0 * dyn.half_clearance).astype(float),
+        contact_lost=jnp.any(d < 0.0),
+        dte_harmonics=harm,
+        dte_rms=rms,
+        converged=converged,
+        stable=stable,
+        floquet_multiplier=floquet,
+        status=status.astype(jnp.int32),
+        newton_iterations=iters.astype(jnp.int32),
+        periodicity_residual=resid,
+        initial_state=w,
+    )
+
+
+def _check_inputs(pair, op):
+    if is_concrete(op):
+        check_positive("OperatingPoint.speed_rpm", op.speed_rpm, "rpm")
+        check_positive("OperatingPoint.torque", op.torque, "N m")
+    if is_concrete(pair):
+        check_positive("blank_mass", pair.blank_mass, "kg")
+        check_positive("blank_inertia", pair.blank_inertia, "kg m^2")
+
+
+def _mesh_and_interface(pair, op, mesh, interface, options):
+    if mesh is None:
+        from ..gear.mesh import mesh_cycle  # provided by the gear-mesh issue
+
+        mesh = mesh_cycle(pair, torque=op.torque, n_positions=options.n_positions)
+    if interface is None:
+        interface = MeshInterface.zeros(mesh.n_positions)
+    return mesh, interface
+
+
+def _steady_state(pair, op, mesh, interface, options, guess):
+    dyn = build_dynamics(pair, op, mesh, interface, options)
+    cold = static_guess(dyn)
+    guess = cold if guess is None else jnp.where(jnp.all(jnp.isfinite(guess)), guess, cold)
+    batch = jax.tree_util.tree_map(lambda a: a[None], dyn)
+    w, aux = _batch_solve(batch, guess[None], options, fallback_from=cold[None])
+    return _postprocess(dyn, mesh, op, w[0], _index(aux, 0), options)
+
+
+@eqx.filter_jit
+def _dynamic_response_jit(pair, op, mesh, interface, options, guess):
+    mesh, interface = _mesh_and_interface(pair, op, mesh, interface, options)
+    return _steady_state(pair, op, mesh, interface, options, guess)
+
+
+def dynamic_response(
+    pair,
+    op: OperatingPoint,
+    *,
+    mesh=None,
+    interface: MeshInterface | None = None,
+    options: DynamicsOptions | None = None,
+    initial_state=None,
+) -> DynamicResponse:
+    """Periodic steady-state dynamic response of ``pair`` at ``op`` over one mesh cycle.
+
+    Args:
+        pair: GearPair (masses, inertias, bearings, backlash 2ℓ).
+        op: OperatingPoint (torque T1 in N m on gear 1, speed of gear 1 in rpm).
+        mesh: MeshCycle (default ``jg.mesh_cycle(pair, torque=op.torque, n_positions=options.n_positions)``).
+        interface: MeshInterface over the mesh's positions (default zeros: dry, frictionless).
+        options: DynamicsOptions (backlash model, steps per period, Newton settings).
+        initial_state: shooting unknowns [13] to start Newton from (e.g. ``initial_state`` of a
+            neighbouring speed); default the static equilibrium.
+
+    Returns:
+        DynamicResponse. Differentiable (forward mode: ``jax.jvp``/``jax.jacfwd``) in every traced input
+        by implicit differentiation of the periodicity condition.
+    """
+    options = DynamicsOptions() if options is None else options
+    _check_inputs(pair, op)
+    # NaN marks "no guess" so that passing a guess or not shares one compiled function.
+    guess = jnp.full(13, jnp.nan) if initial_state is None else jnp.asarray(initial_state, float)
+    return _dynamic_response_jit(pair, op, mesh, interface, options, guess)
+
+
+def _at_speed(op: OperatingPoint, speed_rpm) -> OperatingPoint:
+    return eqx.tree_at(lambda o: o.speed_rpm, op, jnp.asarray(speed_rpm, float))
+
+
+def _rescale_guess(w, old_speed, new_speed):
+    # Velocities in the scaled state are per mesh period: keep dq/dt, rescale dq/dτ.
+    factor = old_speed / new_speed
+    return w.at[6:12].multiply(factor)
+
+
+@eqx.filter_jit
+def _sweep_parallel(pair, op, speeds, mesh, interface, options):
+    mesh, interface = _mesh_and_interface(pair, op, mesh, interface, options)
+
+    def dyn_at(speed):
+        return build_dynamics(pair, _at_speed(op, speed), mesh, interface, options)
+
+    dyns = jax.vmap(dyn_at)(speeds)
+    guesses = jax.vmap(static_guess)(dyns)
+    w, aux = _batch_solve(dyns, guesses, options)
+
+    def post(speed, dyn, w, aux):
+        return _postprocess(dyn, mesh, _at_speed(op, speed), w, aux, options)
+
+    return jax.vmap(post)(speeds, dyns, w, aux)
+
+
+@eqx.filter_jit
+def _sweep_continuation(pair, op, speeds, mesh, interface, options):
+    mesh, interface = _mesh_and_interface(pair, op, mesh, interface, options)
+
+    def step(carry, speed):
+        w_prev, speed_prev, have_prev = carry
+        op_n = _at_speed(op, speed)
+        dyn = build_dynamics(pair, op_n, mesh, interface, options)
+        cold = static_guess(dyn)
+        guess = jnp.where(have_prev, _rescale_guess(w_prev, speed_prev, speed), cold)
+        # Newton from the previous orbit; if that branch has disappeared (no convergence, or only an
+        # unstable orbit is left), the state left by the previous speed decays to the new attractor:
+        # this is the jump.
+        batch = jax.tree_util.tree_map(lambda a: a[None], dyn)
+        w, aux = _batch_solve(batch, guess[None], options)
+        w, aux = w[0], _index(aux, 0)
+        res = _postprocess(dyn, mesh, op_n, w, aux, options)
+        ok = res.converged
+        new_carry = (jnp.where(ok, w, w_prev), jnp.where(ok, speed, speed_prev), have_prev | ok)
+        return new_carry, res
+
+    init = (jnp.zeros(13), speeds[0], jnp.asarray(False))
+    _, out = jax.lax.scan(step, init, speeds)
+    return out
+
+
+def dynamic_response_sweep(
+    pair,
+    op: OperatingPoint,
+    speeds_rpm,
+    *,
+    mode: str = "parallel",
+    mesh=None,
+    interface: MeshInterface | None = None,
+    options: DynamicsOptions | None = None,
+):
+    """Steady-state responses over gear 1 speeds ``speeds_rpm`` (rpm), torque ``op.torque``.
+
+    Modes:
+        "parallel": every speed independently from the static equilibrium (``vmap``).
+        "continuation": speeds in the given order with ``lax.scan``, each Newton started from the
+            previous orbit (the paper's stepwise speed change); a lost branch restarts from static
+            equilibrium, which is how jumps appear.
+        "up_down": continuation up the ascending speeds and back down; returns ``(up, down)``, both
+            ordered by ascending speed, so that hysteresis shows as up ≠ down.
+
+    Returns:
+        DynamicResponse with a leading speed axis (a pair of them for "up_down").
+    """
+    options = DynamicsOptions() if options is None else options
+    speeds = jnp.asarray(speeds_rpm, dtype=float)
+    if speeds.ndim != 1 or speeds.shape[0] < 1:
+        raise ValueError(f"speeds_rpm must be a non-empty 1-D array; got shape {speeds.shape}")
+    check_positive("speeds_rpm", speeds, "rpm")
+    _check_inputs(pair, op)
+    if mode == "parallel":
+        return _sweep_parallel(pair, op, speeds, mesh, interface, options)
+    if mode == "continuation":
+        return _sweep_continuation(pair, op, speeds, mesh, interface, options)
+    if mode == "up_down":
+        asc = jnp.sort(speeds)
+        up = _sweep_continuation(pair, op, asc, mesh, interface, options)
+        down = _sweep_continuation(pair, op, asc[::-1], mesh, interface, options)
+        down = jax.tree_util.tree_map(lambda a: a[::-1], down)
+        return up, down
+    raise ValueError(
+        f"mode = {mode!r} is not valid; valid choices: 'parallel', 'continuation', 'up_down'"
+    )
