@@ -21,11 +21,6 @@ from .gear.pair import TipRelief as TipRelief
 from .material import Material as Material
 
 __version__ = "0.1.0"
-from .lubrication import thermal as thermal
-from .lubrication.friction_models import ConstantFriction as ConstantFriction
-from .lubrication.friction_models import FrictionModel as FrictionModel
-from .lubrication.friction_models import XuFriction as XuFriction
-from .lubrication.roughness import Surfaces as Surfaces
 from .dynamics import DynamicResponse as DynamicResponse
 from .dynamics import DynamicsOptions as DynamicsOptions
 from .dynamics import MeshInterface as MeshInterface
@@ -34,4 +29,9 @@ from .dynamics import dynamic_response as dynamic_response
 from .dynamics import dynamic_response_sweep as dynamic_response_sweep
 from .dynamics import mode_shapes as mode_shapes
 from .dynamics import natural_frequencies as natural_frequencies
+from .lubrication import thermal as thermal
+from .lubrication.friction_models import ConstantFriction as ConstantFriction
+from .lubrication.friction_models import FrictionModel as FrictionModel
+from .lubrication.friction_models import XuFriction as XuFriction
+from .lubrication.roughness import Surfaces as Surfaces
 from .operating import OperatingPoint as OperatingPoint

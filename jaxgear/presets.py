@@ -31,6 +31,8 @@ def li2015_pair(tip_relief: float = 10e-6, relief_start_deg: float = 20.9) -> Ge
             amount=tip_relief, start_roll_angle=math.radians(relief_start_deg), shape="linear"
         ),
     )
+
+
 from .lubrication.roughness import ground as ground  # noqa: E402
 from .lubrication.roughness import polished as polished  # noqa: E402
 from .lubrication.roughness import smooth as smooth  # noqa: E402
