@@ -35,3 +35,8 @@ from .lubrication.friction_models import FrictionModel as FrictionModel
 from .lubrication.friction_models import XuFriction as XuFriction
 from .lubrication.roughness import Surfaces as Surfaces
 from .operating import OperatingPoint as OperatingPoint
+from .lubrication.ehl import EHLModel as EHLModel
+from .lubrication.ehl import EHLSolution as EHLSolution
+from .lubrication.ehl import LineContact as LineContact
+from .lubrication.ehl import solve_ehl as solve_ehl
+from .lubrication.lubricant import Lubricant as Lubricant

@@ -1,0 +1,781 @@
+# ruff: noqa: F722  (jaxtyping shape strings)
+"""Isothermal smooth line-contact EHL: steady and one-step transient, Newtonian or Eyring, with
+implicit gradients.
+
+Method (EHL_NOTES, REFERENCE §8): Hertz-scaled variables; unknowns P at the N nodes and the film
+offset
+H0, with the load balance Δ Σ P = π/2 as the extra row of a bordered Newton system; cavitation as a
+smoothed Fischer-Burmeister complementarity (``reynolds.py``); exact log-kernel deformation
+(``deformation.py``). The Jacobian is assembled exactly: the local (banded) derivatives of the
+Reynolds
+operator with respect to P and H come from 8 forward-mode products with coloured seeds, the dense
+part is
+the banded H-derivative times the influence matrix. Robustness across the (M, L) range comes from
+continuation in the piezo-viscous exponent on the coarsest grid, coarse-to-fine grid sequencing,
+and a
+backtracking line search on the residual norm; every loop is a ``lax.while_loop``/``lax.scan``.
+A failed solve reports ``converged=False`` with its residual and finite values, never NaN.
+
+Gradients: the converged fine-grid solution u*(θ) of F(u, θ) = 0 is differentiated by the implicit
+function theorem, du = −(∂F/∂u)⁻¹ (∂F/∂θ) dθ (a ``jax.custom_jvp``; reverse mode transposes it),
+never
+through the iterations.
+
+Outputs follow S. Li, Tribol. Int. 88 (2015): heat flux Eq. (12), damping Eq. (13), friction Eq.
+(15).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Bool, Float, Int
+
+from .._validation import (
+    check_choice,
+    check_finite,
+    check_positive,
+    check_range,
+    is_concrete,
+)
+from . import deformation as deformation_mod
+from . import rheology
+from .lubricant import Lubricant
+from .reynolds import (
+    fischer_burmeister,
+    log_smooth_positive,
+    reynolds_residual,
+    smooth_positive,
+)
+
+VISCOSITY_MODELS = ("roelands", "barus")
+COMPRESSIBILITY_MODELS = ("dowson_higginson", "incompressible")
+SHEAR_MODELS = ("newtonian", "eyring_paper", "eyring_exact")
+DEFORMATION_METHODS = ("dense", "fft", "auto")
+
+_LOG_VISCOSITY_CAP = 500.0  # soft cap on ln(η/η0): keeps iterates finite (η/η0 ≤ e^500)
+_FLOOR_FRACTION = 1e-3  # smooth film floor inside ε, relative to the reference film
+
+
+# -------------------------------------------------------------------------------------------------
+# Inputs
+# -------------------------------------------------------------------------------------------------
+class LineContact(eqx.Module):
+    """A smooth line contact, SI units (every field traced).
+
+    Attributes:
+        reduced_radius: R, 1/R = 1/R1 + 1/R2, m.
+        load_per_width: w' = W/L, N/m.
+        u1, u2: surface velocities in the rolling direction, m/s (entrainment um = (u1+u2)/2 > 0).
+        e_reduced: E', 2/E' = (1−ν1²)/E1 + (1−ν2²)/E2, Pa.
+        inlet_temperature: lubricant inlet (and, isothermal, film) temperature, K.
+    """
+
+    reduced_radius: Float[Array, ""] = eqx.field(converter=jnp.asarray)
+    load_per_width: Float[Array, ""] = eqx.field(converter=jnp.asarray)
+    u1: Float[Array, ""] = eqx.field(converter=jnp.asarray)
+    u2: Float[Array, ""] = eqx.field(converter=jnp.asarray)
+    e_reduced: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=2.2747e11)
+    inlet_temperature: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=363.15)
+
+    def __check_init__(self):
+        check_positive("LineContact.reduced_radius", self.reduced_radius, "m")
+        check_positive("LineContact.load_per_width", self.load_per_width, "N/m")
+        check_finite("LineContact.u1", self.u1)
+        check_finite("LineContact.u2", self.u2)
+        check_positive("LineContact.e_reduced", self.e_reduced, "Pa")
+        check_range("LineContact.inlet_temperature", self.inlet_temperature, 200.0, 600.0, unit="K")
+        if is_concrete((self.u1, self.u2)):
+            um = 0.5 * (np.asarray(self.u1) + np.asarray(self.u2))
+            if not np.all(um > 0):
+                raise ValueError(
+                    f"LineContact.u1, u2 give the entrainment velocity (u1+u2)/2 = {um} m/s, "
+                    "out of range; valid range: (0, inf) m/s"
+                )
+
+    @property
+    def rolling_velocity(self):
+        """um = (u1 + u2)/2, m/s."""
+        return 0.5 * (self.u1 + self.u2)
+
+    @property
+    def sliding_velocity(self):
+        """us = u1 − u2, m/s."""
+        return self.u1 - self.u2
+
+    @property
+    def hertz_half_width(self):
+        """b = √(8 w' R/(π E')), m."""
+        return jnp.sqrt(8.0 * self.load_per_width * self.reduced_radius / (jnp.pi * self.e_reduced))
+
+    @property
+    def hertz_pressure(self):
+        """ph = √(w' E'/(2π R)), Pa."""
+        return jnp.sqrt(self.load_per_width * self.e_reduced / (2.0 * jnp.pi * self.reduced_radius))
+
+
+class EHLModel(eqx.Module):
+    """Static configuration of ``solve_ehl`` (hashable; changing it recompiles).
+
+    Attributes:
+        n_nodes: grid nodes N; (N − 1) should hold a power of 2 for grid sequencing.
+        x_in, x_out: domain in Hertz half-widths (widened automatically for thick films,
+        ``auto_domain``).
+        auto_domain: widen the inlet to √(50 H_est) and the outlet to 1.2 √(2 H_est) when larger,
+            H_est the Moes central film in Hertz units (fully flooded inlet at low M).
+        viscosity: "roelands" or "barus".
+        compressibility: "dowson_higginson" or "incompressible".
+        shear: "newtonian", "eyring_paper" (η* = η/cosh(τm/τ0), paper Eq. 4) or "eyring_exact"
+            (τ = τ0 asinh(η us/(τ0 h))). It enters Reynolds' flow coefficient and the friction/heat
+            terms.
+        fb_smoothing: δ of the Fischer-Burmeister function.
+        tolerance: ‖F‖∞ below which a Newton solve has converged.
+        max_iterations: Newton iterations per grid level (and per continuation step).
+        coarsest_nodes: smallest grid of the sequence.
+        continuation_steps: steps of the piezo-viscous exponent (s = 1/n … 1) on the coarsest grid.
+        warm_iterations: Newton iterations allowed for a warm start before falling back to a cold
+        solve.
+        deformation: "dense", "fft" (DC-FFT for residuals; the Jacobian stays dense), "auto" (fft
+        above
+            1025 nodes).
+        wedge_order: upwind order of the wedge term (1 or 2).
+    """
+
+    n_nodes: int = eqx.field(static=True, default=257)
+    x_in: float = eqx.field(static=True, default=-4.5)
+    x_out: float = eqx.field(static=True, default=1.5)
+    auto_domain: bool = eqx.field(static=True, default=True)
+    viscosity: str = eqx.field(static=True, default="roelands")
+    compressibility: str = eqx.field(static=True, default="dowson_higginson")
+    shear: str = eqx.field(static=True, default="eyring_paper")
+    fb_smoothing: float = eqx.field(static=True, default=1e-6)
+    tolerance: float = eqx.field(static=True, default=1e-9)
+    max_iterations: int = eqx.field(static=True, default=30)
+    coarsest_nodes: int = eqx.field(static=True, default=65)
+    continuation_steps: int = eqx.field(static=True, default=4)
+    warm_iterations: int = eqx.field(static=True, default=12)
+    deformation: str = eqx.field(static=True, default="auto")
+    wedge_order: int = eqx.field(static=True, default=2)
+
+    def __check_init__(self):
+        if not isinstance(self.n_nodes, int) or self.n_nodes < 17:
+            raise ValueError(
+                f"EHLModel.n_nodes = {self.n_nodes!r} is out of range; valid range: [17, inf)"
+            )
+        if not (self.x_in < 0.0 < self.x_out):
+            raise ValueError(
+                f"EHLModel.x_in, x_out = {self.x_in}, {self.x_out} are out of range; "
+                "valid range: x_in < 0 < x_out (Hertz half-widths)"
+            )
+        check_choice("EHLModel.viscosity", self.viscosity, VISCOSITY_MODELS)
+        check_choice("EHLModel.compressibility", self.compressibility, COMPRESSIBILITY_MODELS)
+        check_choice("EHLModel.shear", self.shear, SHEAR_MODELS)
+        check_choice("EHLModel.deformation", self.deformation, DEFORMATION_METHODS)
+        check_choice("EHLModel.wedge_order", self.wedge_order, (1, 2))
+        check_range("EHLModel.fb_smoothing", self.fb_smoothing, 0.0, 1e-2, low_inclusive=False)
+        check_range("EHLModel.tolerance", self.tolerance, 0.0, 1e-2, low_inclusive=False)
+        for name in ("max_iterations", "continuation_steps", "warm_iterations"):
+            v = getattr(self, name)
+            if not isinstance(v, int) or v < 1:
+                raise ValueError(f"EHLModel.{name} = {v!r} is out of range; valid range: [1, inf)")
+
+    @property
+    def grid_sizes(self) -> tuple[int, ...]:
+        """Node counts of the grid sequence, coarse to fine."""
+        sizes = [self.n_nodes]
+        while (sizes[-1] - 1) % 2 == 0 and (sizes[-1] - 1) // 2 + 1 >= self.coarsest_nodes:
+            sizes.append((sizes[-1] - 1) // 2 + 1)
+        return tuple(reversed(sizes))
+
+    def use_fft(self, n: int) -> bool:
+        return self.deformation == "fft" or (self.deformation == "auto" and n > 1025)
+
+
+class EHLSolution(eqx.Module):
+    """Result of ``solve_ehl``, SI units, per unit face width where forces or powers.
+
+    Attributes:
+        x: node positions, m, (N,) (x = 0 at the Hertz centre, entrainment towards +x).
+        p: pressure, Pa. h: film thickness, m. density: ρ, kg/m³. viscosity: η, Pa s.
+        shear_viscosity: η_s of the shear model (η, η* or τ h/us), Pa s.
+        temperature: film temperature, K (the inlet temperature: isothermal).
+        heat_flux, heat_flux_sliding, heat_flux_rolling: Q of paper Eq. (12) and its two parts,
+        W/m².
+        h_min, h_central: minimum and central (x = 0) film, m. h0: film offset, m. p_max: Pa.
+        friction_sliding: Fs = ∫ η_s (u2 − u1)/h dx, N/m (paper Eq. 15, fluid part; sign of Eq. 15).
+        friction_rolling: Fr = ∫ (h/2) ∂p/∂x dx, N/m (paper Eq. 15).
+        damping: cm = ∫ η_s/h dx, N s/m² (paper Eq. 13 per unit width).
+        power_loss, power_loss_sliding, power_loss_rolling: ∫ Q dx and its parts, W/m.
+        load_error: (∫ p dx − w')/w'.
+        hertz_half_width (m), hertz_pressure (Pa), moes_m, moes_l: scales of the contact.
+        converged, residual (‖F‖∞ of the fine-grid system), iterations (Newton, all levels).
+    """
+
+    x: Float[Array, " N"]
+    p: Float[Array, " N"]
+    h: Float[Array, " N"]
+    density: Float[Array, " N"]
+    viscosity: Float[Array, " N"]
+    shear_viscosity: Float[Array, " N"]
+    temperature: Float[Array, " N"]
+    heat_flux: Float[Array, " N"]
+    heat_flux_sliding: Float[Array, " N"]
+    heat_flux_rolling: Float[Array, " N"]
+    h_min: Float[Array, ""]
+    h_central: Float[Array, ""]
+    h0: Float[Array, ""]
+    p_max: Float[Array, ""]
+    friction_sliding: Float[Array, ""]
+    friction_rolling: Float[Array, ""]
+    damping: Float[Array, ""]
+    power_loss: Float[Array, ""]
+    power_loss_sliding: Float[Array, ""]
+    power_loss_rolling: Float[Array, ""]
+    load_error: Float[Array, ""]
+    hertz_half_width: Float[Array, ""]
+    hertz_pressure: Float[Array, ""]
+    moes_m: Float[Array, ""]
+    moes_l: Float[Array, ""]
+    converged: Bool[Array, ""]
+    residual: Float[Array, ""]
+    iterations: Int[Array, ""]
+
+    @property
+    def rho_h(self):
+        """ρ h at the nodes, kg/m² (the previous-step input of a transient solve)."""
+        return self.density * self.h
+
+
+class _Inputs(eqx.Module):
+    """Every continuous input of a solve (the θ of the implicit differentiation)."""
+
+    contact: LineContact
+    lubricant: Lubricant
+    rho_h_previous: Float[Array, " N"]  # kg/m², on this solve's nodes
+    inv_time_step: Float[Array, ""]  # 1/Δt, 1/s (0: steady)
+    film_offset: Float[Array, " N"]  # m, added to h (roughness terms of issue 4; zero here)
+
+
+# -------------------------------------------------------------------------------------------------
+# Dimensionless problem
+# -------------------------------------------------------------------------------------------------
+def moes_central_film(m, l):
+    """Moes' central film H_M = (hc/R)(2U)^(−1/2) for given M, L (REFERENCE §8)."""
+    h_ri = 3.0 / m
+    h_ei = 2.621 * m ** (-0.2)
+    h_rp = 1.287 * l ** (2.0 / 3.0)
+    h_ep = 1.311 * m ** (-0.125) * l**0.75
+    s = (7.0 + 8.0 * jnp.exp(-2.0 * l * m ** (-0.4))) / 5.0
+    a = (h_ri ** (7.0 / 3.0) + h_ei ** (7.0 / 3.0)) ** (3.0 * s / 7.0)
+    b = (h_rp ** (-3.5) + h_ep ** (-3.5)) ** (-2.0 * s / 7.0)
+    return (a + b) ** (1.0 / s)
+
+
+class _Scales(eqx.Module):
+    b: Array
+    ph: Array
+    um: Array
+    us: Array
+    eta0: Array
+    log_eta0: Array
+    rho0: Array
+    log_lambda: Array
+    log_kappa: Array  # ln(η0 |us| R/(τ0 b²)): Eyring parameter s = κ η̄/H
+    squeeze: Array
+    h_ref: Array
+    x_in: Array
+    x_out: Array
+    moes_m: Array
+    moes_l: Array
+
+
+def _scales(model: EHLModel, inp: _Inputs) -> _Scales:
+    c, lub = inp.contact, inp.lubricant
+    r, w, e = c.reduced_radius, c.load_per_width, c.e_reduced
+    b = c.hertz_half_width
+    ph = c.hertz_pressure
+    um = c.rolling_velocity
+    us = c.sliding_velocity
+    t_in = c.inlet_temperature
+    log_eta0 = lub.log_base_viscosity(t_in)
+    eta0 = jnp.exp(log_eta0)
+    rho0 = lub.density_at(0.0, t_in, compressible=False)
+    log_lambda = jnp.log(12.0 * eta0 * um * r**2 / (b**3 * ph))
+    abs_us = jnp.sqrt(us * us + (1e-6 * um) ** 2)  # smooth |us| (gradient-safe at pure rolling)
+    log_kappa = jnp.log(eta0 * abs_us * r / (lub.eyring_stress * b**2))
+    alpha = lub.pressure_viscosity_coefficient(t_in)
+    u_dim = eta0 * um / (e * r)
+    w_dim = w / (e * r)
+    m = w_dim * (2.0 * u_dim) ** -0.5
+    l = alpha * e * (2.0 * u_dim) ** 0.25
+    h_ref = moes_central_film(m, l) * jnp.pi / (8.0 * m)
+    x_in, x_out = jnp.asarray(model.x_in), jnp.asarray(model.x_out)
+    if model.auto_domain:
+        x_in = jnp.minimum(x_in, -jnp.sqrt(50.0 * h_ref))
+        x_out = jnp.maximum(x_out, 1.2 * jnp.sqrt(2.0 * h_ref))
+    squeeze = b * inp.inv_time_step / um
+    return _Scales(
+        b,
+        ph,
+        um,
+        us,
+        eta0,
+        log_eta0,
+        rho0,
+        log_lambda,
+        log_kappa,
+        squeeze,
+        h_ref,
+        x_in,
+        x_out,
+        m,
+        l,
+    )
+
+
+def _grid(sc: _Scales, n: int):
+    x = jnp.linspace(0.0, 1.0, n) * (sc.x_out - sc.x_in) + sc.x_in
+    return x, (sc.x_out - sc.x_in) / (n - 1)
+
+
+def _log_shear_factor(model: EHLModel, log_s):
+    from .rheology import log_eyring_exact_factor, log_eyring_paper_factor
+
+    if model.shear == "eyring_paper":
+        return log_eyring_paper_factor(log_s)
+    if model.shear == "eyring_exact":
+        return log_eyring_exact_factor(log_s)
+    return jnp.zeros_like(log_s)
+
+
+class _Level(eqx.Module):
+    """The discrete system on one grid: F(u) = 0, u = [P (n), H0]."""
+
+    model: EHLModel = eqx.field(static=True)
+    n: int = eqx.field(static=True)
+    inp: _Inputs
+    sc: _Scales
+    x: Array
+    spacing: Array
+    kernel: Array  # dense influence matrix (n, n)
+    temperature: Array
+    log_eta0_nodes: Array  # ln η0(T) at the nodes (ambient pressure), η in Pa s
+    alpha_nodes: Array  # α(T) at the nodes, 1/Pa
+    rho_nodes: Array  # ρ(0, T)/ρ0 at the nodes
+    offset: Array  # dimensionless film offset
+    rho_h_prev: Array  # dimensionless ρ̄H of the previous step
+
+    def deformation(self, p):
+        if self.model.use_fft(self.n):
+            return deformation_mod.deformation_fft(p, self.spacing)
+        return self.kernel @ p
+
+    def film(self, u):
+        p, h0 = u[: self.n], u[self.n]
+        return h0 + 0.5 * self.x**2 + self.offset + self.deformation(p)
+
+    def local(self, p, h, s):
+        """Node-wise FB residual as a function of P and H (banded dependence, bandwidth −2…+1)."""
+        m, sc = self.model, self.sc
+        pressure = sc.ph * p
+        log_eta = self.log_eta0_nodes - sc.log_eta0
+        if m.viscosity == "barus":
+            log_eta = log_eta + rheology.barus_log_pressure_factor(pressure, self.alpha_nodes)
+        else:
+            log_eta = log_eta + rheology.roelands_log_pressure_factor(
+                pressure, self.log_eta0_nodes, self.inp.lubricant.roelands_z
+            )
+        log_eta = s * log_eta
+        log_eta = _LOG_VISCOSITY_CAP - jax.nn.softplus(_LOG_VISCOSITY_CAP - log_eta)
+        if m.compressibility == "dowson_higginson":
+            rho = self.rho_nodes * rheology.dowson_higginson_density(pressure, 0.0, 1.0, 0.0, 0.0)
+        else:
+            rho = self.rho_nodes
+        log_h = log_smooth_positive(h, _FLOOR_FRACTION * sc.h_ref)
+        log_eta_s = log_eta + _log_shear_factor(m, sc.log_kappa + log_eta - log_h)
+        log_eps = jnp.log(rho) + 3.0 * log_h - log_eta_s - sc.log_lambda
+        r, diag = reynolds_residual(
+            p, rho * h, log_eps, self.spacing, sc.squeeze, self.rho_h_prev, m.wedge_order
+        )
+        f = fischer_burmeister(p, -r / (1.0 + diag), m.fb_smoothing)
+        return f.at[0].set(p[0]).at[-1].set(p[-1])
+
+    def load_row(self, p):
+        return (self.spacing * jnp.sum(p) - 0.5 * jnp.pi) / (0.5 * jnp.pi)
+
+    def residual(self, u, s=1.0):
+        p = u[: self.n]
+        return jnp.concatenate([self.local(p, self.film(u), s), self.load_row(p)[None]])
+
+    def jacobian(self, u, s=1.0):
+        n = self.n
+        p = u[:n]
+        h = self.film(u)
+        _, lin = jax.linearize(lambda pp, hh: self.local(pp, hh, s), p, h)
+        colour = jnp.arange(n)[None, :] % 4 == jnp.arange(4)[:, None]
+        seeds = colour.astype(p.dtype)
+        zero = jnp.zeros_like(seeds)
+        jp = jax.vmap(lin)(seeds, zero)  # (4, n): row i, coloured column
+        jh = jax.vmap(lin)(zero, seeds)
+        rows = jnp.arange(n)
+        dense = jnp.zeros((n, n), dtype=p.dtype)
+        h0_col = jnp.zeros(n, dtype=p.dtype)
+        for k in (-2, -1, 0, 1):
+            col = rows + k
+            valid = (col >= 0) & (col < n)
+            dp = jnp.where(valid, jp[col % 4, rows], 0.0)
+            dh = jnp.where(valid, jh[col % 4, rows], 0.0)
+            dense = dense.at[rows, jnp.clip(col, 0, n - 1)].add(dp)
+            dense = dense + dh[:, None] * jnp.roll(self.kernel, -k, axis=0)
+            h0_col = h0_col + dh
+        top = jnp.concatenate([dense, h0_col[:, None]], axis=1)
+        bottom = jnp.concatenate(
+            [jnp.full((1, n), self.spacing / (0.5 * jnp.pi), dtype=p.dtype), jnp.zeros((1, 1))],
+            axis=1,
+        )
+        return jnp.concatenate([top, bottom], axis=0)
+
+
+def _make_level(model: EHLModel, inp: _Inputs, sc: _Scales, n: int, fine_n: int) -> _Level:
+    x, spacing = _grid(sc, n)
+    kernel = deformation_mod.influence_matrix(n, spacing)
+    r = inp.contact.reduced_radius
+    h_scale = sc.b**2 / r
+    t = jnp.full((n,), inp.contact.inlet_temperature)
+    if n == fine_n:
+        offset = inp.film_offset / h_scale
+        prev = inp.rho_h_previous / (sc.rho0 * h_scale)
+    else:
+        x_fine, _ = _grid(sc, fine_n)
+        offset = jnp.interp(x, x_fine, inp.film_offset) / h_scale
+        prev = jnp.interp(x, x_fine, inp.rho_h_previous) / (sc.rho0 * h_scale)
+    lub = inp.lubricant
+    log_eta0 = lub.log_base_viscosity(t)
+    alpha = rheology.roelands_pressure_viscosity_coefficient(log_eta0, lub.roelands_z)
+    rho = lub.density_at(0.0, t, compressible=False) / sc.rho0
+    return _Level(model, n, inp, sc, x, spacing, kernel, t, log_eta0, alpha, rho, offset, prev)
+
+
+# -------------------------------------------------------------------------------------------------
+# Newton with backtracking
+# -------------------------------------------------------------------------------------------------
+def _norm_inf(f):
+    return jnp.max(jnp.abs(f))
+
+
+def _newton(level: _Level, u0, s, max_iter: int):
+    """Damped Newton on level's system. Returns (u, ‖F‖∞, iterations, converged)."""
+    tol = level.model.tolerance
+
+    def merit(u):
+        f = level.residual(u, s)
+        m = jnp.sum(f * f)
+        return f, jnp.where(jnp.isfinite(m), m, jnp.inf)
+
+    f0, m0 = merit(u0)
+
+    def cond(state):
+        u, f, m, it, stop = state
+        return (~stop) & (it < max_iter)
+
+    def body(state):
+        u, f, m, it, _ = state
+        jac = level.jacobian(u, s)
+        d = jnp.linalg.solve(jac, -f)
+        d = jnp.where(jnp.isfinite(d), d, 0.0)
+
+        # backtracking α = 1, 1/2, … (Armijo on ½‖F‖²); one call site keeps the compiled loop small
+        def ls_cond(ls):
+            alpha, _, m_new, k = ls
+            return (m_new > (1.0 - 1e-4 * alpha) * m) & (k < 12)
+
+        def ls_body(ls):
+            alpha, _, _, k = ls
+            alpha = jnp.where(k == 0, 1.0, 0.5 * alpha)
+            f_new, m_new = merit(u + alpha * d)
+            return alpha, f_new, m_new, k + 1
+
+        alpha, f_new, m_new, _ = jax.lax.while_loop(
+            ls_cond,
+            ls_body,
+            (jnp.asarray(1.0, dtype=u.dtype), f, jnp.asarray(jnp.inf, dtype=u.dtype), 0),
+        )
+        ok = jnp.isfinite(m_new)
+        u_new = jnp.where(ok, u + alpha * d, u)
+        f_new = jnp.where(ok, f_new, f)
+        m_new = jnp.where(ok, m_new, m)
+        done = _norm_inf(f_new) < tol
+        stalled = (~ok) | (alpha * _norm_inf(d) < 1e-15)
+        return u_new, f_new, m_new, it + 1, done | stalled
+
+    init = (u0, f0, m0, jnp.asarray(0), _norm_inf(f0) < tol)
+    u, f, m, it, _ = jax.lax.while_loop(cond, body, init)
+    res = _norm_inf(f)
+    return u, res, it, res < tol
+
+
+def _hertz_start(level: _Level):
+    p = jnp.sqrt(jnp.maximum(1.0 - level.x**2, 0.0))
+    p = p * (0.5 * jnp.pi) / (level.spacing * jnp.sum(p))
+    defo = level.deformation(p)
+    # film offset such that the central film equals the Moes estimate
+    h0 = level.sc.h_ref - jnp.interp(0.0, level.x, defo + level.offset)
+    return jnp.concatenate([p, h0[None]])
+
+
+def _transfer(coarse: _Level, fine: _Level, u):
+    p = jnp.interp(fine.x, coarse.x, u[: coarse.n])
+    p = p.at[0].set(0.0).at[-1].set(0.0)
+    # keep the central film across the transfer (H0 absorbs the O(Δ) change of the discrete kernel)
+    hc = jnp.interp(0.0, coarse.x, coarse.film(u))
+    h0 = hc - jnp.interp(0.0, fine.x, fine.deformation(p) + fine.offset)
+    return jnp.concatenate([p, h0[None]])
+
+
+def _cold_solve(model: EHLModel, levels: list[_Level]):
+    coarse = levels[0]
+    u = _hertz_start(coarse)
+    steps = model.continuation_steps
+    svals = jnp.arange(1, steps + 1, dtype=u.dtype) / steps
+
+    def cont(carry, s):
+        u, it = carry
+        u_new, res, k, ok = _newton(coarse, u, s, model.max_iterations)
+        return (u_new, it + k), None
+
+    (u, iters), _ = jax.lax.scan(cont, (u, jnp.asarray(0)), svals)
+    res = jnp.asarray(jnp.inf)
+    ok = jnp.asarray(False)
+    for prev, lev in zip(levels[:-1], levels[1:], strict=False):
+        u = _transfer(prev, lev, u)
+        u, res, k, ok = _newton(lev, u, 1.0, model.max_iterations)
+        iters = iters + k
+    if len(levels) == 1:
+        _, res, _, ok = _newton(coarse, u, 1.0, 0)
+    return u, res, iters, ok
+
+
+# -------------------------------------------------------------------------------------------------
+# The differentiable solve
+# -------------------------------------------------------------------------------------------------
+def _levels(model: EHLModel, inp: _Inputs):
+    sc = _scales(model, inp)
+    sizes = model.grid_sizes
+    return sc, [_make_level(model, inp, sc, n, sizes[-1]) for n in sizes]
+
+
+def _warm_start(fine: _Level, init_x, init_p, init_h0):
+    sc = fine.sc
+    p = jnp.interp(fine.x * sc.b, init_x, init_p, left=0.0, right=0.0) / sc.ph
+    p = p.at[0].set(0.0).at[-1].set(0.0)
+    h0 = init_h0 * fine.inp.contact.reduced_radius / sc.b**2
+    return jnp.concatenate([p, h0[None]])
+
+
+@functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1))
+def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_h0):
+    """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats."""
+    sc, levels = _levels(model, inp)
+    fine = levels[-1]
+    if warm:
+        u0 = _warm_start(fine, init_x, init_p, init_h0)
+        u_w, res_w, it_w, ok_w = _newton(fine, u0, 1.0, model.warm_iterations)
+
+        def keep(_):
+            return u_w, res_w, it_w, ok_w
+
+        def cold(_):
+            u_c, res_c, it_c, ok_c = _cold_solve(model, levels)
+            return u_c, res_c, it_c + it_w, ok_c
+
+        u, res, it, ok = jax.lax.cond(ok_w, keep, cold, None)
+    else:
+        u, res, it, ok = _cold_solve(model, levels)
+    finite = jnp.all(jnp.isfinite(u))
+    fallback = _hertz_start(fine)
+    u = jnp.where(finite, u, fallback)
+    res = jnp.where(finite & jnp.isfinite(res), res, jnp.finfo(u.dtype).max)
+    ok = ok & finite
+    return u, res, it.astype(u.dtype), ok.astype(u.dtype)
+
+
+@_solve_core.defjvp
+def _solve_core_jvp(model, warm, primals, tangents):
+    inp, init_x, init_p, init_h0 = primals
+    d_inp = tangents[0]
+    u, res, it, ok = _solve_core(model, warm, inp, init_x, init_p, init_h0)
+
+    def fine_residual(theta):
+        _, levels = _levels(model, theta)
+        return levels[-1].residual(u, 1.0)
+
+    _, levels = _levels(model, inp)
+    jac = levels[-1].jacobian(u, 1.0)
+    _, df = jax.jvp(fine_residual, (inp,), (d_inp,))
+    du = -jnp.linalg.solve(jac, df)
+    z = jnp.zeros_like(res)
+    return (u, res, it, ok), (du, z, z, z)
+
+
+def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
+    sc, levels = _levels(model, inp)
+    lev = levels[-1]
+    c, lub = inp.contact, inp.lubricant
+    n = lev.n
+    r = c.reduced_radius
+    h_scale = sc.b**2 / r
+    p_dim = sc.ph * u[:n]
+    big_h = lev.film(u)
+    h = big_h * h_scale
+    x = lev.x * sc.b
+    dx = lev.spacing * sc.b
+    t = lev.temperature
+    rho = lub.density_at(p_dim, t, model.compressibility == "dowson_higginson")
+    log_eta = lub.log_viscosity(p_dim, t, model.viscosity)
+    eta = jnp.exp(log_eta)
+    h_eff = smooth_positive(h, _FLOOR_FRACTION * sc.h_ref * h_scale)
+    abs_us = jnp.sqrt(sc.us**2 + (1e-6 * sc.um) ** 2)
+    log_s = log_eta + jnp.log(abs_us / (lub.eyring_stress * h_eff))
+    eta_s = jnp.exp(log_eta + _log_shear_factor(model, log_s))
+    dpdx = jnp.gradient(p_dim, dx)
+    # Fill fraction of the cavitated outlet: the mass flux through x = 0 carried as Couette streaks.
+    rho_h = rho * h
+    eps_flux = rho * h**3 / (12.0 * eta_s) * dpdx
+    q = jnp.interp(0.0, x, rho_h * sc.um - eps_flux)
+    fill = jnp.where(x > 0.0, jnp.minimum(1.0, q / (sc.um * rho_h)), 1.0)
+    weights = jnp.full((n,), dx).at[0].set(0.5 * dx).at[-1].set(0.5 * dx)
+    q_slide = fill * eta_s * sc.us**2 / h_eff  # paper Eq. (12), sliding part
+    q_roll = h_eff**3 / (12.0 * eta_s) * dpdx**2  # paper Eq. (12), rolling (Poiseuille) part
+    fs = jnp.sum(weights * fill * eta_s * (c.u2 - c.u1) / h_eff)  # paper Eq. (15)
+    fr = jnp.sum(weights * 0.5 * h * dpdx)  # paper Eq. (15)
+    cm = jnp.sum(weights * fill * eta_s / h_eff)  # paper Eq. (13) per unit width
+    # sub-grid minimum film by a parabola through the smallest node and its neighbours
+    i = jnp.clip(jnp.argmin(big_h), 1, n - 2)
+    hm, h_0, hp = big_h[i - 1], big_h[i], big_h[i + 1]
+    curv = hm - 2.0 * h_0 + hp
+    safe = jnp.where(curv > 0, curv, 1.0)
+    h_min = jnp.where(curv > 0, h_0 - (hp - hm) ** 2 / (8.0 * safe), h_0) * h_scale
+    h_central = jnp.interp(0.0, lev.x, big_h) * h_scale
+    load_err = jnp.sum(weights * p_dim) / c.load_per_width - 1.0
+    return EHLSolution(
+        x=x,
+        p=p_dim,
+        h=h,
+        density=rho,
+        viscosity=eta,
+        shear_viscosity=eta_s,
+        temperature=t,
+        heat_flux=q_slide + q_roll,
+        heat_flux_sliding=q_slide,
+        heat_flux_rolling=q_roll,
+        h_min=h_min,
+        h_central=h_central,
+        h0=u[n] * h_scale,
+        p_max=jnp.max(p_dim),
+        friction_sliding=fs,
+        friction_rolling=fr,
+        damping=cm,
+        power_loss=jnp.sum(weights * (q_slide + q_roll)),
+        power_loss_sliding=jnp.sum(weights * q_slide),
+        power_loss_rolling=jnp.sum(weights * q_roll),
+        load_error=load_err,
+        hertz_half_width=sc.b,
+        hertz_pressure=sc.ph,
+        moes_m=sc.moes_m,
+        moes_l=sc.moes_l,
+        converged=ok > 0.5,
+        residual=res,
+        iterations=jax.lax.stop_gradient(it).astype(jnp.int32),
+    )
+
+
+@eqx.filter_jit
+def _solve_jit(model, warm, inp, init_x, init_p, init_h0):
+    u, res, it, ok = _solve_core(model, warm, inp, init_x, init_p, init_h0)
+    return _postprocess(model, inp, u, res, it, ok)
+
+
+def solve_ehl(
+    contact: LineContact,
+    lubricant: Lubricant,
+    model: EHLModel | None = None,
+    surfaces=None,
+    *,
+    initial: EHLSolution | None = None,
+    previous: EHLSolution | None = None,
+    time_step=None,
+) -> EHLSolution:
+    """Solve a smooth isothermal line-contact EHL problem (steady, or one backward-Euler step).
+
+    Args:
+        contact: the LineContact (SI).
+        lubricant: the Lubricant.
+        model: static EHLModel (default ``EHLModel()``: 257 nodes, Roelands, Dowson-Higginson,
+            paper Eyring).
+        surfaces: must be ``None`` (smooth surfaces; mixed lubrication is issue 4).
+        initial: a previous EHLSolution to warm-start from (any contact; its p(x) is interpolated
+        and
+            its h0 reused). A failed warm start falls back to a cold solve.
+        previous: the solution at the previous time step; with ``time_step`` Δt (s) the squeeze term
+            ∂(ρh)/∂t ≈ (ρh − ρh_prev)/Δt is included (backward Euler). ρh_prev is interpolated onto
+            this solve's nodes (same nodes when the contact's Hertz half-width is unchanged).
+        time_step: Δt, s (required with ``previous``).
+
+    Returns:
+        EHLSolution (SI, per unit width), with ``converged``, ``residual`` and ``iterations``.
+    """
+    model = EHLModel() if model is None else model
+    if not isinstance(model, EHLModel):
+        raise ValueError(f"model = {model!r} is not valid; valid: an EHLModel")
+    if surfaces is not None:
+        raise ValueError(
+            "surfaces = (rough surfaces) is not valid; valid: None (smooth EHL). Mixed lubrication "
+            "with roughness is not implemented yet"
+        )
+    if not isinstance(contact, LineContact):
+        raise ValueError(f"contact = {type(contact).__name__} is not valid; valid: a LineContact")
+    if not isinstance(lubricant, Lubricant):
+        raise ValueError(f"lubricant = {type(lubricant).__name__} is not valid; valid: a Lubricant")
+    n = model.n_nodes
+    dtype = jnp.result_type(float)
+    if previous is not None:
+        if time_step is None:
+            raise ValueError(
+                "time_step = None is not valid with previous=; valid range: (0, inf) s"
+            )
+        check_positive("time_step", time_step, "s")
+        inv_dt = 1.0 / jnp.asarray(time_step, dtype=dtype)
+        b = contact.hertz_half_width
+        x_here = _grid_positions(model, contact, lubricant)
+        rho_h_prev = jnp.interp(x_here, previous.x, previous.rho_h)
+        del b
+    else:
+        inv_dt = jnp.zeros((), dtype=dtype)
+        rho_h_prev = jnp.zeros((n,), dtype=dtype)
+    inp = _Inputs(contact, lubricant, rho_h_prev, inv_dt, jnp.zeros((n,), dtype=dtype))
+    if initial is not None:
+        return _solve_jit(model, True, inp, initial.x, initial.p, initial.h0)
+    z = jnp.zeros((2,), dtype=dtype)
+    return _solve_jit(model, False, inp, z, z, jnp.zeros((), dtype=dtype))
+
+
+def _grid_positions(model: EHLModel, contact: LineContact, lubricant: Lubricant):
+    """Node positions x (m) of ``solve_ehl``'s fine grid for this contact."""
+    n = model.n_nodes
+    inp = _Inputs(contact, lubricant, jnp.zeros((n,)), jnp.zeros(()), jnp.zeros((n,)))
+    sc = _scales(model, inp)
+    x, _ = _grid(sc, n)
+    return x * sc.b
+
+
+def hertz_film_scale(contact: LineContact):
+    """b²/R, m: the film thickness unit of the Hertz scaling H = h R/b²."""
+    return contact.hertz_half_width**2 / contact.reduced_radius
+
+
+_ = math  # (kept for symbolic constants in future thermal terms)
