@@ -33,8 +33,8 @@ def li2015_pair(tip_relief: float = 10e-6, relief_start_deg: float = 20.9) -> Ge
     )
 
 
+from .lubrication.lubricant import iso_vg68 as iso_vg68  # noqa: E402
+from .lubrication.lubricant import mil_l_23699 as mil_l_23699  # noqa: E402
 from .lubrication.roughness import ground as ground  # noqa: E402
 from .lubrication.roughness import polished as polished  # noqa: E402
 from .lubrication.roughness import smooth as smooth  # noqa: E402
-from .lubrication.lubricant import iso_vg68 as iso_vg68  # noqa: E402
-from .lubrication.lubricant import mil_l_23699 as mil_l_23699  # noqa: E402

@@ -266,17 +266,27 @@ def _quasi_static(pair, lubricant, surfaces, op, fidelity, mesh):
     return _assemble(pair, op, mesh, forces, load, velocity, mesh.static_te, status, 0.0, 0)
 
 
-def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh):
+def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     options = _dynamics_options(fidelity)
+    m = mesh.n_positions
 
     def respond(interface, guess):
         return dynamic_response(
             pair, op, mesh=mesh, interface=interface, options=options, initial_state=guess
         )
 
-    def forces_of(resp):
+    beta = fidelity.relaxation
+
+    # The fixed-point state carries, beside the interface tables, the orbit (a warm start for the next
+    # shooting) and what the result needs (tooth forces, velocities, DTE, contact forces), so the
+    # dynamics and the contacts are traced once, inside the iteration.
+    def step(state, _):
+        interface = state["interface"]
+        # Before the first orbit exists, shoot from the static equilibrium (NaN guess).
+        guess = jnp.where(state["started"] > 0.5, state["guess"], jnp.nan)
+        resp = respond(interface, guess)
         u = resp.surface_velocity
-        return contact_forces(
+        forces = contact_forces(
             pair,
             lubricant,
             surfaces,
@@ -287,20 +297,37 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh):
             u[..., 1],
             op.inlet_temperature,
         )
-
-    # Start: dry dynamics, then the contacts at that state.
-    resp0 = respond(MeshInterface.zeros(mesh.n_positions), None)
-    x0 = (interface_from_forces(forces_of(resp0)), resp0.initial_state)
-    beta = fidelity.relaxation
-
-    def step(x, _):
-        interface, guess = x
-        resp = respond(interface, guess)
-        new = interface_from_forces(forces_of(resp))
+        new = interface_from_forces(forces)
         relaxed = jax.tree_util.tree_map(lambda a, b: (1.0 - beta) * a + beta * b, interface, new)
-        return relaxed, resp.initial_state
+        return {
+            "interface": relaxed,
+            "guess": resp.initial_state,
+            "load": resp.tooth_force,
+            "velocity": u,
+            "dte": resp.dynamic_te,
+            "forces": forces,
+            "dynamics_ok": jnp.where(resp.status == 0, 1.0, 0.0),
+            "started": jnp.ones_like(state["started"]),
+            "previous": interface.friction_1,
+        }
 
-    # Scale of the tables for the relative tolerance: the load (friction) and a damping scale.
+    zeros = jnp.zeros((m, 2), dtype=op.torque.dtype)
+    if warm is None:
+        interface0 = MeshInterface(damping=zeros, friction_1=zeros, friction_2=zeros)
+        guess0, started0 = jnp.zeros(13, dtype=zeros.dtype), 0.0
+    else:  # continuation: the neighbouring point's converged interface and orbit
+        interface0, guess0, started0 = warm.interface, warm.orbit, 1.0
+    state0 = {
+        "interface": interface0,
+        "guess": guess0,
+        "load": mesh.normal_load,
+        "velocity": kinematic_velocities(pair, mesh, op.omega1),
+        "dte": mesh.static_te,
+        "forces": ContactForces(zeros, zeros, zeros, zeros, zeros, zeros, jnp.asarray(True)),
+        "dynamics_ok": jnp.asarray(1.0, dtype=zeros.dtype),
+        "started": jnp.asarray(started0, dtype=zeros.dtype),
+        "previous": zeros,
+    }
     solver = optx.FixedPointIteration(
         rtol=fidelity.fixed_point_tolerance,
         atol=fidelity.fixed_point_tolerance * 1e-3,
@@ -310,25 +337,22 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh):
     sol = optx.fixed_point(
         step,
         solver,
-        x0,
+        state0,
         max_steps=fidelity.max_fixed_point_iterations,
         adjoint=adjoint,
         throw=False,
     )
-    interface, guess = sol.value
-    resp = respond(interface, guess)
-    forces = forces_of(resp)
-    new = interface_from_forces(forces)
-    scale = jnp.maximum(jnp.max(jnp.abs(new.friction_1)), 1e-12)
-    residual = jax.lax.stop_gradient(
-        jnp.max(jnp.abs(new.friction_1 - interface.friction_1)) / scale
-    )
+    state = sol.value
+    forces = state["forces"]
+    new = state["interface"].friction_1
+    scale = jnp.maximum(jnp.max(jnp.abs(new)), 1e-12)
+    residual = jax.lax.stop_gradient(jnp.max(jnp.abs(new - state["previous"])) / scale)
     fp_ok = sol.result == optx.RESULTS.successful
     status = jnp.where(
         ~fp_ok,
         STATUS_FIXED_POINT,
         jnp.where(
-            resp.status != 0,
+            state["dynamics_ok"] < 0.5,
             STATUS_DYNAMICS,
             jnp.where(forces.converged, STATUS_OK, STATUS_CONTACT),
         ),
@@ -338,21 +362,38 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh):
         op,
         mesh,
         forces,
-        resp.tooth_force,
-        resp.surface_velocity,
-        resp.dynamic_te,
+        state["load"],
+        state["velocity"],
+        state["dte"],
         status,
         residual,
         sol.stats["num_steps"],
     )
 
 
-@eqx.filter_jit
-def _simulate(pair, lubricant, surfaces, op, fidelity):
+class WarmStart(eqx.Module):
+    """A converged tribo-dynamic state to start a neighbouring point from (continuation sweeps)."""
+
+    interface: MeshInterface
+    orbit: Float[Array, " 13"]
+
+
+def simulate_with_state(pair, lubricant, surfaces, op, fidelity, warm: WarmStart | None = None):
+    """``simulate`` that also returns the WarmStart of its converged state (traceable: no checks).
+
+    The quasi-static rung has no state: its WarmStart is zeros, and ``warm`` is ignored.
+    """
     mesh = mesh_cycle(pair, op.torque, fidelity.n_positions, stiffness=fidelity.stiffness)
     if fidelity.dynamics == "quasi_static":
-        return _quasi_static(pair, lubricant, surfaces, op, fidelity, mesh)
-    return _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh)
+        zeros = jnp.zeros((fidelity.n_positions, 2), dtype=op.torque.dtype)
+        none = WarmStart(MeshInterface(zeros, zeros, zeros), jnp.zeros(13, dtype=zeros.dtype))
+        return _quasi_static(pair, lubricant, surfaces, op, fidelity, mesh), none
+    return _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm)
+
+
+@eqx.filter_jit
+def _simulate(pair, lubricant, surfaces, op, fidelity):
+    return simulate_with_state(pair, lubricant, surfaces, op, fidelity)[0]
 
 
 def simulate(
