@@ -47,9 +47,11 @@ STATUS_NAMES = {
     STATUS_NON_FINITE: "non-finite result",
 }
 
-# Width of the smooth sign of the sliding velocity (m/s): far below the sliding speeds of a mesh
-# except within ~1e-3 of the pitch point, where it keeps friction forces and gradients continuous.
-_SIGN_WIDTH = 1e-3
+# The friction force of the formula rungs changes sign with the sliding velocity through a smooth
+# sign over a slide-to-roll ratio of SIGN_SLIDE_TO_ROLL: real EHL traction grows linearly with slip up
+# to ~1-2 % SRR before it saturates, and a discontinuous sign makes the tribo-dynamic fixed point
+# chatter between neighbouring states (vibration moves the sign change from one position to the next).
+SIGN_SLIDE_TO_ROLL = 0.02
 
 
 class ContactForces(eqx.Module):
@@ -119,7 +121,7 @@ def formula_contact_forces(
         )
         mu = jnp.where(loaded, mu, 0.0)
     force = mu * jnp.where(loaded, load, 0.0)
-    sign = _smooth_sign(u2 - u1, _SIGN_WIDTH)
+    sign = _smooth_sign(u2 - u1, SIGN_SLIDE_TO_ROLL * 0.5 * jnp.abs(u1 + u2) + 1e-9)
     zeros = jnp.zeros_like(force)
     return ContactForces(
         friction_sliding=force * sign,
@@ -357,7 +359,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             jnp.where(forces.converged, STATUS_OK, STATUS_CONTACT),
         ),
     )
-    return _assemble(
+    result = _assemble(
         pair,
         op,
         mesh,
@@ -369,6 +371,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         residual,
         sol.stats["num_steps"],
     )
+    return result, WarmStart(interface=state["interface"], orbit=state["guess"])
 
 
 class WarmStart(eqx.Module):
