@@ -12,7 +12,7 @@ import importlib
 import sys
 
 # Subcommand modules, in the order shown by --help.
-COMMANDS = ("mesh",)
+COMMANDS = ("run", "mesh")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -22,6 +22,7 @@ import optimistix as optx
 from jaxtyping import Array, Bool, Float, Int
 
 from ._validation import check_non_negative, is_concrete
+from .anderson import Anderson
 from .dynamics.model import DynamicsOptions, MeshInterface
 from .dynamics.response import dte_harmonic_amplitudes, dynamic_response
 from .fidelity import Fidelity
@@ -277,7 +278,8 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             pair, op, mesh=mesh, interface=interface, options=options, initial_state=guess
         )
 
-    beta = fidelity.relaxation
+    # Plain iteration damps inside the map; Anderson damps in its mixing (same fixed point).
+    beta = fidelity.relaxation if fidelity.anderson_memory == 0 else 1.0
 
     # The fixed-point state carries, beside the interface tables, the orbit (a warm start for the next
     # shooting) and what the result needs (tooth forces, velocities, DTE, contact forces), so the
@@ -330,11 +332,22 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         "started": jnp.asarray(started0, dtype=zeros.dtype),
         "previous": zeros,
     }
-    solver = optx.FixedPointIteration(
-        rtol=fidelity.fixed_point_tolerance,
-        atol=fidelity.fixed_point_tolerance * 1e-3,
-        norm=optx.max_norm,
-    )
+    if fidelity.anderson_memory > 0:
+        # Anderson mixing of the interface tables and the orbit; the carried outputs follow T.
+        solver = Anderson(
+            rtol=fidelity.fixed_point_tolerance,
+            atol=fidelity.fixed_point_tolerance * 1e-3,
+            memory=fidelity.anderson_memory,
+            beta=fidelity.relaxation,
+            core=lambda st: (st["interface"], st["guess"]),
+            replace_core=lambda st, c: {**st, "interface": c[0], "guess": c[1]},
+        )
+    else:
+        solver = optx.FixedPointIteration(
+            rtol=fidelity.fixed_point_tolerance,
+            atol=fidelity.fixed_point_tolerance * 1e-3,
+            norm=optx.max_norm,
+        )
     adjoint = optx.ImplicitAdjoint(linear_solver=lx.GMRES(rtol=1e-10, atol=1e-10, restart=20))
     sol = optx.fixed_point(
         step,
