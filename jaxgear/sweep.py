@@ -162,7 +162,7 @@ def sweep(
             f"cannot sweep {sorted(unknown)}; sweepable inputs: {', '.join(SWEEPABLE)}"
         )
     if speeds_rpm is not None:
-        vary["speed_rpm"] = speeds_rpm
+        vary = {"speed_rpm": speeds_rpm, **vary}  # speed first: the CSV's leading column
     if not vary:
         raise ValueError("nothing to sweep: give speeds_rpm or another input from SWEEPABLE")
     n = max(np.size(v) for v in vary.values())
