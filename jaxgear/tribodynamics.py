@@ -135,16 +135,23 @@ def formula_contact_forces(
     )
 
 
-def contact_forces(pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature):
-    """Dispatch on ``fidelity.friction`` (a static choice: unused rungs are never traced)."""
+def contact_forces(
+    pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature, initial=None
+):
+    """Dispatch on ``fidelity.friction`` (a static choice: unused rungs are never traced).
+
+    Returns (ContactForces, contact state): the contact state is the batch of EHL solutions on the EHL
+    rungs (a warm start for the next evaluation, and the fields), None on the formula rungs.
+    """
     if fidelity.friction in ("constant", "regression"):
-        return formula_contact_forces(
+        forces = formula_contact_forces(
             pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature
         )
+        return forces, None
     from .lubrication.contacts import ehl_contact_forces
 
     return ehl_contact_forces(
-        pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature
+        pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature, initial
     )
 
 
@@ -254,7 +261,7 @@ def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, ite
 def _quasi_static(pair, lubricant, surfaces, op, fidelity, mesh):
     velocity = kinematic_velocities(pair, mesh, op.omega1)
     load = mesh.normal_load
-    forces = contact_forces(
+    forces, _ = contact_forces(
         pair,
         lubricant,
         surfaces,
@@ -290,7 +297,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         guess = jnp.where(state["started"] > 0.5, state["guess"], jnp.nan)
         resp = respond(interface, guess)
         u = resp.surface_velocity
-        forces = contact_forces(
+        forces, contacts = contact_forces(
             pair,
             lubricant,
             surfaces,
@@ -300,6 +307,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             u[..., 0],
             u[..., 1],
             op.inlet_temperature,
+            state["contacts"],
         )
         new = interface_from_forces(forces)
         relaxed = jax.tree_util.tree_map(lambda a, b: (1.0 - beta) * a + beta * b, interface, new)
@@ -313,6 +321,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             "dynamics_ok": jnp.where(resp.status == 0, 1.0, 0.0),
             "started": jnp.ones_like(state["started"]),
             "previous": interface.friction_1,
+            "contacts": contacts,
         }
 
     zeros = jnp.zeros((m, 2), dtype=op.torque.dtype)
@@ -321,13 +330,28 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         guess0, started0 = jnp.zeros(13, dtype=zeros.dtype), 0.0
     else:  # continuation: the neighbouring point's converged interface and orbit
         interface0, guess0, started0 = warm.interface, warm.orbit, 1.0
+    velocity0 = kinematic_velocities(pair, mesh, op.omega1)
+    # EHL rungs: cold solves at the quasi-static state, then every iteration warm-starts from the last
+    # (one cold and one warm trace of the solver); formula rungs carry no contact state.
+    forces0, contacts0 = contact_forces(
+        pair,
+        lubricant,
+        surfaces,
+        mesh,
+        fidelity,
+        mesh.normal_load,
+        velocity0[..., 0],
+        velocity0[..., 1],
+        op.inlet_temperature,
+    )
     state0 = {
         "interface": interface0,
         "guess": guess0,
         "load": mesh.normal_load,
-        "velocity": kinematic_velocities(pair, mesh, op.omega1),
+        "velocity": velocity0,
         "dte": mesh.static_te,
-        "forces": ContactForces(zeros, zeros, zeros, zeros, zeros, zeros, jnp.asarray(True)),
+        "forces": forces0,
+        "contacts": contacts0,
         "dynamics_ok": jnp.asarray(1.0, dtype=zeros.dtype),
         "started": jnp.asarray(started0, dtype=zeros.dtype),
         "previous": zeros,
