@@ -49,8 +49,20 @@ def influence_matrix(n: int, spacing):
     Returns:
         (n, n) array; the film is H = H0 + X²/2 + D @ P.
     """
-    k0 = jnp.asarray(unit_matrix(n))
+    k = jnp.asarray(unit_kernel(n))
+    idx = jnp.arange(n)
+    k0 = k[
+        jnp.abs(idx[:, None] - idx[None, :])
+    ]  # gathered at run time: no N² constant in the program
     return -(spacing / jnp.pi) * (k0 + jnp.log(spacing))
+
+
+def influence_vector(n: int, spacing, pad: int = 0):
+    """The Toeplitz generator d(m) of ``influence_matrix`` (D[i, j] = d(i − j)) for
+    m = −(n − 1 + pad) … n − 1 + pad, as a 1-D array of length 2(n + pad) − 1."""
+    k = unit_kernel(n + pad)
+    full = np.concatenate([k[:0:-1], k])
+    return -(spacing / jnp.pi) * (jnp.asarray(full) + jnp.log(spacing))
 
 
 def deformation_dense(pressure, spacing):

@@ -48,7 +48,6 @@ from . import rheology
 from .lubricant import Lubricant
 from .reynolds import (
     fischer_burmeister,
-    log_smooth_positive,
     reynolds_residual,
     smooth_positive,
 )
@@ -58,7 +57,7 @@ COMPRESSIBILITY_MODELS = ("dowson_higginson", "incompressible")
 SHEAR_MODELS = ("newtonian", "eyring_paper", "eyring_exact")
 DEFORMATION_METHODS = ("dense", "fft", "auto")
 
-_LOG_VISCOSITY_CAP = 500.0  # soft cap on ln(η/η0): keeps iterates finite (η/η0 ≤ e^500)
+_LOG_VISCOSITY_CAP = 500.0  # cap on ln(η/η0): keeps iterates finite (η/η0 ≤ e^500)
 _FLOOR_FRACTION = 1e-3  # smooth film floor inside ε, relative to the reference film
 
 
@@ -157,7 +156,7 @@ class EHLModel(eqx.Module):
     tolerance: float = eqx.field(static=True, default=1e-9)
     max_iterations: int = eqx.field(static=True, default=30)
     coarsest_nodes: int = eqx.field(static=True, default=65)
-    continuation_steps: int = eqx.field(static=True, default=4)
+    continuation_steps: int = eqx.field(static=True, default=10)
     warm_iterations: int = eqx.field(static=True, default=12)
     deformation: str = eqx.field(static=True, default="auto")
     wedge_order: int = eqx.field(static=True, default=2)
@@ -265,12 +264,18 @@ class _Inputs(eqx.Module):
 # Dimensionless problem
 # -------------------------------------------------------------------------------------------------
 def moes_central_film(m, l):
-    """Moes' central film H_M = (hc/R)(2U)^(−1/2) for given M, L (REFERENCE §8)."""
+    """Moes' central film H_M = (hc/R)(2U)^(−1/2) for given M, L (line contact, Barus, incompressible).
+
+    H_RI = 3/M, H_EI = 2.621 M^(−1/5), H_RP = 1.287 L^(2/3), H_EP = 1.311 M^(−1/8) L^(3/4),
+    H_M = [(H_RI^(7/3) + H_EI^(7/3))^(3s/7) + (H_RP^(−7/2) + H_EP^(−7/2))^(−2s/7)]^(1/s) with
+    s = (7 + 8 exp(−2 H_EI/H_RI))/5 (C.H. Venner & A.A. Lubrecht, Multilevel Methods in Lubrication,
+    2000). Used here only as the starting estimate of the film.
+    """
     h_ri = 3.0 / m
     h_ei = 2.621 * m ** (-0.2)
     h_rp = 1.287 * l ** (2.0 / 3.0)
     h_ep = 1.311 * m ** (-0.125) * l**0.75
-    s = (7.0 + 8.0 * jnp.exp(-2.0 * l * m ** (-0.4))) / 5.0
+    s = (7.0 + 8.0 * jnp.exp(-2.0 * h_ei / h_ri)) / 5.0
     a = (h_ri ** (7.0 / 3.0) + h_ei ** (7.0 / 3.0)) ** (3.0 * s / 7.0)
     b = (h_rp ** (-3.5) + h_ep ** (-3.5)) ** (-2.0 * s / 7.0)
     return (a + b) ** (1.0 / s)
@@ -391,14 +396,18 @@ class _Level(eqx.Module):
                 pressure, self.log_eta0_nodes, self.inp.lubricant.roelands_z
             )
         log_eta = s * log_eta
-        log_eta = _LOG_VISCOSITY_CAP - jax.nn.softplus(_LOG_VISCOSITY_CAP - log_eta)
+        log_eta = jnp.minimum(log_eta, _LOG_VISCOSITY_CAP)
         if m.compressibility == "dowson_higginson":
             rho = self.rho_nodes * rheology.dowson_higginson_density(pressure, 0.0, 1.0, 0.0, 0.0)
         else:
             rho = self.rho_nodes
-        log_h = log_smooth_positive(h, _FLOOR_FRACTION * sc.h_ref)
-        log_eta_s = log_eta + _log_shear_factor(m, sc.log_kappa + log_eta - log_h)
-        log_eps = jnp.log(rho) + 3.0 * log_h - log_eta_s - sc.log_lambda
+        h_eff = smooth_positive(h, _FLOOR_FRACTION * sc.h_ref)
+        if m.shear == "newtonian":
+            log_eta_s = log_eta
+        else:
+            log_s = sc.log_kappa + log_eta - jnp.log(h_eff)
+            log_eta_s = log_eta + _log_shear_factor(m, log_s)
+        log_eps = jnp.log(rho * h_eff**3) - log_eta_s - sc.log_lambda
         r, diag = reynolds_residual(
             p, rho * h, log_eps, self.spacing, sc.squeeze, self.rho_h_prev, m.wedge_order
         )
@@ -423,16 +432,21 @@ class _Level(eqx.Module):
         jp = jax.vmap(lin)(seeds, zero)  # (4, n): row i, coloured column
         jh = jax.vmap(lin)(zero, seeds)
         rows = jnp.arange(n)
-        dense = jnp.zeros((n, n), dtype=p.dtype)
-        h0_col = jnp.zeros(n, dtype=p.dtype)
-        for k in (-2, -1, 0, 1):
+        offsets = (-2, -1, 0, 1)
+        dps, dhs = [], []
+        for k in offsets:
             col = rows + k
             valid = (col >= 0) & (col < n)
-            dp = jnp.where(valid, jp[col % 4, rows], 0.0)
-            dh = jnp.where(valid, jh[col % 4, rows], 0.0)
-            dense = dense.at[rows, jnp.clip(col, 0, n - 1)].add(dp)
-            dense = dense + dh[:, None] * jnp.roll(self.kernel, -k, axis=0)
-            h0_col = h0_col + dh
+            dps.append(jnp.where(valid, jp[col % 4, rows], 0.0))
+            dhs.append(jnp.where(valid, jh[col % 4, rows], 0.0))
+        # J[i, j] = Σ_k dP_k[i] [j = i + k] + Σ_k dH_k[i] D[i + k, j], with the Toeplitz influence
+        # matrix D[i, j] = d(i − j) read from a padded 1-D kernel: one fused pass over n² entries.
+        kern = deformation_mod.influence_vector(n, self.spacing, pad=2)  # d(m), m = −(n+1) … n+1
+        m = rows[:, None] - rows[None, :]
+        dense = jnp.zeros((n, n), dtype=p.dtype)
+        for k, dp, dh in zip(offsets, dps, dhs, strict=True):
+            dense = dense + dh[:, None] * kern[m + k + n + 1] + jnp.where(m == -k, dp[:, None], 0.0)
+        h0_col = sum(dhs)
         top = jnp.concatenate([dense, h0_col[:, None]], axis=1)
         bottom = jnp.concatenate(
             [jnp.full((1, n), self.spacing / (0.5 * jnp.pi), dtype=p.dtype), jnp.zeros((1, 1))],
@@ -537,27 +551,31 @@ def _transfer(coarse: _Level, fine: _Level, u):
     return jnp.concatenate([p, h0[None]])
 
 
-def _cold_solve(model: EHLModel, levels: list[_Level]):
+def _cold_start(model: EHLModel, levels: list[_Level]):
+    """Continuation in the piezo-viscous exponent on the coarsest grid, then grid sequencing up to the
+    second-finest grid; returns the fine-grid starting point and the Newton iterations spent."""
     coarse = levels[0]
     u = _hertz_start(coarse)
     steps = model.continuation_steps
-    svals = jnp.arange(1, steps + 1, dtype=u.dtype) / steps
+    # a single grid stops the continuation short of s = 1: the fine solve that follows finishes it
+    last = steps + 1 if len(levels) > 1 else steps
+    if last <= 1:
+        return u, jnp.asarray(0)
+    svals = jnp.arange(1, last, dtype=u.dtype) / steps
 
     def cont(carry, s):
         u, it = carry
-        u_new, res, k, ok = _newton(coarse, u, s, model.max_iterations)
+        u_new, _, k, _ = _newton(coarse, u, s, model.max_iterations)
         return (u_new, it + k), None
 
     (u, iters), _ = jax.lax.scan(cont, (u, jnp.asarray(0)), svals)
-    res = jnp.asarray(jnp.inf)
-    ok = jnp.asarray(False)
-    for prev, lev in zip(levels[:-1], levels[1:], strict=False):
-        u = _transfer(prev, lev, u)
-        u, res, k, ok = _newton(lev, u, 1.0, model.max_iterations)
-        iters = iters + k
     if len(levels) == 1:
-        _, res, _, ok = _newton(coarse, u, 1.0, 0)
-    return u, res, iters, ok
+        return u, iters
+    for prev, lev in zip(levels[:-2], levels[1:-1], strict=False):
+        u = _transfer(prev, lev, u)
+        u, _, k, _ = _newton(lev, u, 1.0, model.max_iterations)
+        iters = iters + k
+    return _transfer(levels[-2], levels[-1], u), iters
 
 
 # -------------------------------------------------------------------------------------------------
@@ -579,23 +597,45 @@ def _warm_start(fine: _Level, init_x, init_p, init_h0):
 
 @functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1))
 def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_h0):
-    """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats."""
+    """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats.
+
+    The fine-grid Newton loop appears once in the program: a warm solve is a scan over two attempts
+    (the warm start, then, only if that failed, the cold start), so compile time does not double."""
     sc, levels = _levels(model, inp)
     fine = levels[-1]
-    if warm:
-        u0 = _warm_start(fine, init_x, init_p, init_h0)
-        u_w, res_w, it_w, ok_w = _newton(fine, u0, 1.0, model.warm_iterations)
-
-        def keep(_):
-            return u_w, res_w, it_w, ok_w
-
-        def cold(_):
-            u_c, res_c, it_c, ok_c = _cold_solve(model, levels)
-            return u_c, res_c, it_c + it_w, ok_c
-
-        u, res, it, ok = jax.lax.cond(ok_w, keep, cold, None)
+    if not warm:
+        u0, it0 = _cold_start(model, levels)
+        u, res, k, ok = _newton(fine, u0, 1.0, model.max_iterations)
+        it = it0 + k
     else:
-        u, res, it, ok = _cold_solve(model, levels)
+        u_warm = _warm_start(fine, init_x, init_p, init_h0)
+
+        def attempt(carry, first):
+            u, res, it, ok = carry
+
+            def cold(_):
+                return _cold_start(model, levels)
+
+            def again(_):
+                return u, jnp.asarray(0)
+
+            start, k0 = jax.lax.cond(first | ok, again, cold, None)
+            start = jnp.where(first, u_warm, start)
+            max_iter = jnp.where(
+                first, model.warm_iterations, jnp.where(ok, 0, model.max_iterations)
+            )
+            u1, res1, k1, ok1 = _newton(fine, start, 1.0, max_iter)
+            return (u1, res1, it + k0 + k1, ok1), None
+
+        init = (
+            u_warm,
+            jnp.asarray(jnp.inf, dtype=u_warm.dtype),
+            jnp.asarray(0),
+            jnp.asarray(False),
+        )
+        (u, res, it, ok), _ = jax.lax.scan(attempt, init, jnp.array([True, False]))
+    # a closed (non-positive) film is not a smooth-EHL solution, however small the residual: report it
+    ok = ok & (jnp.min(fine.film(u)) > 0.0)
     finite = jnp.all(jnp.isfinite(u))
     fallback = _hertz_start(fine)
     u = jnp.where(finite, u, fallback)
@@ -650,9 +690,14 @@ def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
     fill = jnp.where(x > 0.0, jnp.minimum(1.0, q / (sc.um * rho_h)), 1.0)
     weights = jnp.full((n,), dx).at[0].set(0.5 * dx).at[-1].set(0.5 * dx)
     q_slide = fill * eta_s * sc.us**2 / h_eff  # paper Eq. (12), sliding part
-    q_roll = h_eff**3 / (12.0 * eta_s) * dpdx**2  # paper Eq. (12), rolling (Poiseuille) part
+    # Poiseuille terms on cell faces, as the Reynolds discretisation has them (flow coefficient
+    # averaged to the face, pressure gradient by the face difference)
+    flow = h_eff**3 / (12.0 * eta_s)
+    dp_face = jnp.diff(p_dim) / dx
+    q_roll_face = 0.5 * (flow[1:] + flow[:-1]) * dp_face**2  # paper Eq. (12), rolling part
+    q_roll = 0.5 * (jnp.pad(q_roll_face, (1, 0)) + jnp.pad(q_roll_face, (0, 1)))
     fs = jnp.sum(weights * fill * eta_s * (c.u2 - c.u1) / h_eff)  # paper Eq. (15)
-    fr = jnp.sum(weights * 0.5 * h * dpdx)  # paper Eq. (15)
+    fr = jnp.sum(0.25 * (h[1:] + h[:-1]) * jnp.diff(p_dim))  # paper Eq. (15): ∫ (h/2) ∂p/∂x dx
     cm = jnp.sum(weights * fill * eta_s / h_eff)  # paper Eq. (13) per unit width
     # sub-grid minimum film by a parabola through the smallest node and its neighbours
     i = jnp.clip(jnp.argmin(big_h), 1, n - 2)
@@ -680,9 +725,9 @@ def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
         friction_sliding=fs,
         friction_rolling=fr,
         damping=cm,
-        power_loss=jnp.sum(weights * (q_slide + q_roll)),
+        power_loss=jnp.sum(weights * q_slide) + jnp.sum(q_roll_face) * dx,
         power_loss_sliding=jnp.sum(weights * q_slide),
-        power_loss_rolling=jnp.sum(weights * q_roll),
+        power_loss_rolling=jnp.sum(q_roll_face) * dx,
         load_error=load_err,
         hertz_half_width=sc.b,
         hertz_pressure=sc.ph,

@@ -31,17 +31,15 @@ def fischer_burmeister(a, b, smoothing):
 
 
 def smooth_positive(h, floor):
-    """A smooth positive floor: ≈ h for h ≫ floor, → floor·ln2 at h = 0, → 0⁺ for h ≪ 0."""
-    return floor * jax.nn.softplus(h / floor)
+    """A smooth positive floor ½(h + √(h² + f²)): ≈ h for h ≫ f, f/2 at h = 0, f²/(4|h|) for h ≪ −f.
 
-
-def log_smooth_positive(h, floor):
-    """ln(smooth_positive(h, floor)), finite with finite derivatives for any h (≈ h/floor + ln floor
-    far below zero)."""
-    z = h / floor
-    very_negative = z < -30.0
-    z_safe = jnp.where(very_negative, 0.0, z)
-    return jnp.log(floor) + jnp.where(very_negative, z, jnp.log(jax.nn.softplus(z_safe)))
+    Written without cancellation on either side, so it is finite and positive with finite derivatives
+    for any h (a gradient-safe double ``where``)."""
+    r = jnp.sqrt(h * h + floor * floor)
+    positive = h > 0.0
+    h_pos = jnp.where(positive, h, 0.0)
+    h_neg = jnp.where(positive, 0.0, h)
+    return jnp.where(positive, 0.5 * (h_pos + r), 0.5 * floor * floor / (r - h_neg))
 
 
 def reynolds_residual(
