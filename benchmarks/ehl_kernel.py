@@ -64,12 +64,23 @@ def main():
         warm_fn = lambda c, init, model=model: jg.solve_ehl(c, LUB, model, initial=init)  # noqa: E731
         warm, w_compile, w_run = timed(warm_fn, neighbour, cold)
         sols[n] = cold
-        rows.append((n, c_compile, c_run, int(cold.iterations), w_compile, w_run, int(warm.iterations),
-                     bool(cold.converged and warm.converged)))
+        rows.append(
+            (
+                n,
+                c_compile,
+                c_run,
+                int(cold.iterations),
+                w_compile,
+                w_run,
+                int(warm.iterations),
+                bool(cold.converged and warm.converged),
+            )
+        )
         print(rows[-1], flush=True)
     # finest-grid reference (2049 nodes, cold)
-    ref, ref_compile, ref_run = timed(lambda c: jg.solve_ehl(c, LUB, jg.EHLModel(n_nodes=2049)), base,
-                                      repeats=1)
+    ref, ref_compile, ref_run = timed(
+        lambda c: jg.solve_ehl(c, LUB, jg.EHLModel(n_nodes=2049)), base, repeats=1
+    )
     errors = {}
     for n in sizes:
         s = sols[n]
@@ -90,8 +101,12 @@ def main():
     batch = eqx.tree_at(
         lambda c: (c.load_per_width, c.reduced_radius, c.u1, c.u2),
         base,
-        (base.load_per_width * (0.8 + 0.4 * k), base.reduced_radius * (0.8 + 0.4 * k),
-         base.u1 * (0.9 + 0.2 * k), base.u2 * (1.1 - 0.2 * k)),
+        (
+            base.load_per_width * (0.8 + 0.4 * k),
+            base.reduced_radius * (0.8 + 0.4 * k),
+            base.u1 * (0.9 + 0.2 * k),
+            base.u2 * (1.1 - 0.2 * k),
+        ),
     )
     vcold = eqx.filter_jit(jax.vmap(lambda c: jg.solve_ehl(c, LUB, model_257)))
     vres, v_compile, v_run = timed(vcold, batch, repeats=3)
@@ -117,10 +132,27 @@ def main():
     vg = eqx.filter_jit(jax.value_and_grad(loss))
     _, _, vg_run = timed(vg, base.load_per_width)
 
-    write_results(rows, errors, ref_run, m_heavy, hv_run, bool(hv.converged), int(hv.iterations),
-                  v_compile, v_run, int(jnp.max(vres.iterations)), bool(jnp.all(vres.converged)),
-                  vw_run, int(jnp.max(vwres.iterations)), bool(jnp.all(vwres.converged)), loop_run,
-                  f_run, g_compile, g_run, vg_run)
+    write_results(
+        rows,
+        errors,
+        ref_run,
+        m_heavy,
+        hv_run,
+        bool(hv.converged),
+        int(hv.iterations),
+        v_compile,
+        v_run,
+        int(jnp.max(vres.iterations)),
+        bool(jnp.all(vres.converged)),
+        vw_run,
+        int(jnp.max(vwres.iterations)),
+        bool(jnp.all(vwres.converged)),
+        loop_run,
+        f_run,
+        g_compile,
+        g_run,
+        vg_run,
+    )
 
 
 def machine():
@@ -132,13 +164,34 @@ def machine():
     except OSError:
         pass
     load = os.getloadavg() if hasattr(os, "getloadavg") else ("?",)
-    return (f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}; jax {jax.__version__}; "
-            f"float64; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}; "
-            f"load average at the end {load[0]:.1f} (CPU shared with other jobs)")
+    return (
+        f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}; jax {jax.__version__}; "
+        f"float64; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}; "
+        f"load average at the end {load[0]:.1f} (CPU shared with other jobs)"
+    )
 
 
-def write_results(rows, errors, ref_run, m_heavy, hv_run, hv_ok, hv_it, v_compile, v_run, v_it, v_ok,
-                  vw_run, vw_it, vw_ok, loop_run, f_run, g_compile, g_run, vg_run):
+def write_results(
+    rows,
+    errors,
+    ref_run,
+    m_heavy,
+    hv_run,
+    hv_ok,
+    hv_it,
+    v_compile,
+    v_run,
+    v_it,
+    v_ok,
+    vw_run,
+    vw_it,
+    vw_ok,
+    loop_run,
+    f_run,
+    g_compile,
+    g_run,
+    vg_run,
+):
     ms = lambda t: f"{t * 1e3:.1f}"  # noqa: E731
     lines = [
         "<!-- BEGIN ehl_kernel -->",
@@ -183,8 +236,12 @@ def write_results(rows, errors, ref_run, m_heavy, hv_run, hv_ok, hv_it, v_compil
     path = Path(__file__).resolve().parent / "RESULTS.md"
     text = path.read_text() if path.exists() else "# Benchmark results\n\n"
     if "<!-- BEGIN ehl_kernel -->" in text:
-        text = re.sub(r"<!-- BEGIN ehl_kernel -->.*<!-- END ehl_kernel -->", lambda _: section, text,
-                      flags=re.S)
+        text = re.sub(
+            r"<!-- BEGIN ehl_kernel -->.*<!-- END ehl_kernel -->",
+            lambda _: section,
+            text,
+            flags=re.S,
+        )
     else:
         text = text.rstrip("\n") + "\n\n" + section + "\n"
     path.write_text(text)
