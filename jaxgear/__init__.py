@@ -40,3 +40,8 @@ from .lubrication.friction_models import XuFriction as XuFriction
 from .lubrication.lubricant import Lubricant as Lubricant
 from .lubrication.roughness import Surfaces as Surfaces
 from .operating import OperatingPoint as OperatingPoint
+from .optimise import OptimisationResult as OptimisationResult
+from .optimise import optimise as optimise
+from .optimise import optimise_roughness_scale as optimise_roughness_scale
+from .optimise import optimise_tip_relief as optimise_tip_relief
+from .optimise import optimise_torque as optimise_torque
