@@ -41,7 +41,7 @@ from .lubrication.lubricant import Lubricant as Lubricant
 from .lubrication.roughness import Surfaces as Surfaces
 from .operating import OperatingPoint as OperatingPoint
 from .optimise import OptimisationResult as OptimisationResult
-from .optimise import optimise as optimise
+from .optimise import optimise as optimise_bounded
 from .optimise import optimise_roughness_scale as optimise_roughness_scale
 from .optimise import optimise_tip_relief as optimise_tip_relief
 from .optimise import optimise_torque as optimise_torque

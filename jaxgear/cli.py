@@ -12,7 +12,7 @@ import importlib
 import sys
 
 # Subcommand modules, in the order shown by --help.
-COMMANDS = ("mesh",)
+COMMANDS = ("mesh", "optimise")
 
 
 def build_parser() -> argparse.ArgumentParser:

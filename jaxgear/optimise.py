@@ -163,7 +163,7 @@ class OptimisationResult(eqx.Module):
 def default_optimiser(learning_rate: float, steps: int) -> optax.GradientTransformation:
     """Adam with a cosine-decayed learning rate (in box units per step), as used by default."""
     schedule = optax.cosine_decay_schedule(learning_rate, max(steps, 1), alpha=0.02)
-    return optax.adam(schedule)
+    return optax.adam(schedule, b2=0.99)
 
 
 @eqx.filter_jit
@@ -212,7 +212,7 @@ def optimise(
     bounds: tuple[Sequence[float], Sequence[float]],
     *,
     steps: int = 40,
-    learning_rate: float = 0.05,
+    learning_rate: float = 0.1,
     optimiser: optax.GradientTransformation | None = None,
     gtol: float = 1e-2,
     names: Sequence[str] | None = None,
@@ -227,7 +227,8 @@ def optimise(
         x0: start, SI [n]; clipped into the bounds.
         bounds: (lower [n], upper [n]), SI, finite, lower < upper.
         steps: optimiser step cap (≥ 0; 0 evaluates the start only).
-        learning_rate: of the default optimiser, in box widths per step (Adam, cosine-decayed to 2 %).
+        learning_rate: of the default optimiser, in box widths per step (Adam with b2 = 0.99 so
+            late steps are not throttled by the large early gradients; cosine-decayed to 2 %).
         optimiser: any optax GradientTransformation (minimising; it sees the negated, normalised
             objective in box units). Overrides ``learning_rate``.
         gtol: converged when the projected gradient norm is ≤ gtol × its value at the start.
@@ -497,7 +498,7 @@ def optimise_tip_relief(
     bounds: dict | None = None,
     shape: str | None = None,
     steps: int = 40,
-    learning_rate: float = 0.05,
+    learning_rate: float = 0.1,
     optimiser: optax.GradientTransformation | None = None,
     both_gears: bool = True,
     gtol: float = 1e-2,
@@ -613,7 +614,7 @@ def optimise_torque(
     speeds_rpm=None,
     fidelity: Fidelity | None = None,
     steps: int = 40,
-    learning_rate: float = 0.05,
+    learning_rate: float = 0.1,
     optimiser: optax.GradientTransformation | None = None,
     gtol: float = 1e-2,
 ) -> OptimisationResult:
@@ -655,7 +656,7 @@ def optimise_roughness_scale(
     speeds_rpm=None,
     fidelity: Fidelity | None = None,
     steps: int = 40,
-    learning_rate: float = 0.05,
+    learning_rate: float = 0.1,
     optimiser: optax.GradientTransformation | None = None,
     gtol: float = 1e-2,
 ) -> OptimisationResult:
