@@ -102,20 +102,12 @@ def run(args: argparse.Namespace) -> int:
         operating_from_config,
     )
     from jaxgear.fidelity import Fidelity
+    from jaxgear.optimise import _check_positive_float, _check_steps
 
     cfg = load_toml(args.config) if args.config else {}
     check_top_level(cfg, ("gear", "operating", "optimise"))
     opt_cfg = dict(cfg.get("optimise", {}))
     check_keys(opt_cfg, _OPTIMISE_KEYS, "optimise")
-    pair = gear_pair_from_config(cfg)
-    op_cfg = operating_from_config(cfg)
-    if args.torque is not None:
-        op_cfg["torque"] = args.torque
-    op = jg.OperatingPoint(
-        torque=op_cfg.get("torque", 700.0),
-        speed_rpm=op_cfg.get("speed_rpm", 2000.0),
-        inlet_temperature=op_cfg.get("inlet_temperature", 363.15),
-    )
     speeds = parse_speeds(args.speeds, args.speed_range)
     if speeds is None and "speeds_rpm" in opt_cfg:
         speeds = parse_speeds(",".join(str(v) for v in opt_cfg["speeds_rpm"]), None)
@@ -125,6 +117,18 @@ def run(args: argparse.Namespace) -> int:
     steps = args.steps if args.steps is not None else opt_cfg.get("steps", 40)
     lr = args.learning_rate if args.learning_rate is not None else opt_cfg.get("learning_rate", 0.1)
     shape = args.shape or opt_cfg.get("shape")
+    # Cheap checks first: bad numbers fail before any geometry or compile work.
+    _check_steps(steps)
+    _check_positive_float("learning_rate", lr)
+    pair = gear_pair_from_config(cfg)
+    op_cfg = operating_from_config(cfg)
+    if args.torque is not None:
+        op_cfg["torque"] = args.torque
+    op = jg.OperatingPoint(
+        torque=op_cfg.get("torque", 700.0),
+        speed_rpm=op_cfg.get("speed_rpm", 2000.0),
+        inlet_temperature=op_cfg.get("inlet_temperature", 363.15),
+    )
     fidelity = (
         Fidelity.fast()
         if args.fidelity == "fast"
