@@ -145,8 +145,8 @@ def test_per_gear_relief_and_step_cap():
     assert "step cap" in r.message
     assert r.history_x.shape == (4, 4)
     np.testing.assert_allclose(r.amount, r.value("tip_relief_amount"))
-    # The 50/50 pair is symmetric: per-gear gradients of amount agree to within 10 % at the start
-    # (gear 1's tip works in the recess, gear 2's in the approach: not exactly equal).
+    # Relief on either gear unloads a tooth end where sliding is fastest: both amount gradients are
+    # positive at the start (gear 1's tip works in the recess, gear 2's in the approach).
     g = r.history_gradient[0]
     assert g[0] > 0 and g[1] > 0
     assert r.objective >= r.objective_start
@@ -249,7 +249,7 @@ def test_non_converged_points_are_never_used():
 )
 def test_bad_input_names_the_field(kwargs, needle):
     kwargs.setdefault("fidelity", QS)
-    with pytest.raises(ValueError, match=None) as err:
+    with pytest.raises(ValueError) as err:
         jg.optimise_tip_relief(jg.presets.li2015_pair(), LUB, SURF, OP, **kwargs)
     assert needle in str(err.value)
 
