@@ -41,6 +41,11 @@ from .lubrication.friction_models import XuFriction as XuFriction
 from .lubrication.lubricant import Lubricant as Lubricant
 from .lubrication.roughness import Surfaces as Surfaces
 from .operating import OperatingPoint as OperatingPoint
+from .optimise import OptimisationResult as OptimisationResult
+from .optimise import optimise as optimise_bounded
+from .optimise import optimise_roughness_scale as optimise_roughness_scale
+from .optimise import optimise_tip_relief as optimise_tip_relief
+from .optimise import optimise_torque as optimise_torque
 from .sweep import SweepResult as SweepResult
 from .sweep import sweep as sweep
 from .tribodynamics import SimulationResult as SimulationResult

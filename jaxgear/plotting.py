@@ -127,3 +127,33 @@ def plot_efficiency(speeds_rpm, dynamic, quasi_static, path):
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return Path(path)
+
+
+def plot_optimisation_history(result, path: str | Path, scales=None, labels=None) -> Path:
+    """Objective, parameters and projected gradient norm against optimiser step (PNG).
+    ``scales``/``labels``: per parameter, a factor and an axis label for display (default SI).
+    """
+    n = len(result.names)
+    scales = np.ones(n) if scales is None else np.asarray(scales, dtype=float)
+    labels = list(result.names) if labels is None else list(labels)
+    steps = np.arange(len(result.history_objective))
+    fig, axes = plt.subplots(1, 2 + n, figsize=(4.2 * (2 + n), 3.6))
+    axes[0].plot(steps, 100.0 * np.asarray(result.history_objective), ".-")
+    axes[0].axhline(100.0 * result.objective, color="k", lw=0.8, ls="--", label="optimum")
+    axes[0].set(xlabel="step", ylabel="mean efficiency (%)", title="Objective")
+    axes[0].legend()
+    for i in range(n):
+        ax = axes[1 + i]
+        ax.plot(steps, np.asarray(result.history_x)[:, i] * scales[i], ".-")
+        for bound in (result.lower[i], result.upper[i]):
+            ax.axhline(bound * scales[i], color="grey", lw=0.8, ls=":")
+        ax.set(xlabel="step", ylabel=labels[i], title=labels[i])
+    gn = np.asarray(result.history_gradient_norm)
+    axes[-1].semilogy(steps, np.where(gn > 0, gn, np.nan), ".-")
+    axes[-1].set(xlabel="step", ylabel="projected gradient norm", title="Stationarity")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"Optimisation: {result.message}", fontsize=9)
+    path = Path(path)
+    fig.savefig(path, dpi=100)
+    return path

@@ -9,8 +9,16 @@ from jaxgear.cli import main
 
 def test_run_writes_results_and_resumes(tmp_path, capsys):
     out = tmp_path / "results"
-    args = ["run", "--speeds", "1000:1500:500", "--out", str(out), "--no-progress",
-            "--chunk-size", "2"]
+    args = [
+        "run",
+        "--speeds",
+        "1000:1500:500",
+        "--out",
+        str(out),
+        "--no-progress",
+        "--chunk-size",
+        "2",
+    ]
     assert main(args) == 0
     for name in ("sweep.csv", "summary.json", "dte_rms.png", "power_loss.png", "efficiency.png"):
         assert (out / name).stat().st_size > 200, name
@@ -31,8 +39,19 @@ def test_run_writes_results_and_resumes(tmp_path, capsys):
 
 def test_run_bad_input_exit_2(tmp_path):
     proc = subprocess.run(
-        [sys.executable, "-m", "jaxgear.cli", "run", "--speeds", "4200:500:25", "--out",
-         str(tmp_path)], capture_output=True, text=True, timeout=300,
+        [
+            sys.executable,
+            "-m",
+            "jaxgear.cli",
+            "run",
+            "--speeds",
+            "4200:500:25",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert proc.returncode == 2
     assert "--speeds" in proc.stderr and "Traceback" not in proc.stderr

@@ -44,7 +44,14 @@ def test_cli_options_toml_and_png_agree(tmp_path, capsys):
         'lubricant = "mil_l_23699"\n[contact]\n'
         + "".join(
             f"{k} = {float(getattr(c, k))!r}\n"
-            for k in ("reduced_radius", "load_per_width", "u1", "u2", "e_reduced", "inlet_temperature")
+            for k in (
+                "reduced_radius",
+                "load_per_width",
+                "u1",
+                "u2",
+                "e_reduced",
+                "inlet_temperature",
+            )
         )
         + "[model]\nn_nodes = 129\n"
     )
@@ -70,6 +77,8 @@ def test_cli_main_exit_code_2_on_bad_input(capsys):
     pytest.importorskip("jaxgear.commands.mesh")
     from jaxgear.cli import main
 
-    code = main(["ehl", "--reduced-radius", "0", "--load-per-width", "1e5", "--u1", "1", "--u2", "1"])
+    code = main(
+        ["ehl", "--reduced-radius", "0", "--load-per-width", "1e5", "--u1", "1", "--u2", "1"]
+    )
     assert code == 2
     assert "reduced_radius" in capsys.readouterr().err

@@ -111,7 +111,9 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"{', '.join(missing)} missing; give them as options or in [contact]")
     unknown = set(contact_cfg) - {n for n, _ in CONTACT_FIELDS}
     if unknown:
-        raise ValueError(f"[contact] {sorted(unknown)} not valid; valid: {[n for n, _ in CONTACT_FIELDS]}")
+        raise ValueError(
+            f"[contact] {sorted(unknown)} not valid; valid: {[n for n, _ in CONTACT_FIELDS]}"
+        )
     lub_name = args.lubricant or cfg.get("lubricant", "mil_l_23699")
     presets = {"mil_l_23699": jg.presets.mil_l_23699, "iso_vg68": jg.presets.iso_vg68}
     if lub_name not in presets:

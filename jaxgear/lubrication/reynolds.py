@@ -21,7 +21,6 @@ smoothing.
 
 from __future__ import annotations
 
-import jax
 import jax.numpy as jnp
 
 
