@@ -131,8 +131,10 @@ def plot_efficiency(speeds_rpm, dynamic, quasi_static, path):
 
 def plot_optimisation_history(result, path: str | Path, scales=None, labels=None) -> Path:
     """Objective, parameters and projected gradient norm against optimiser step (PNG).
+
     ``scales``/``labels``: per parameter, a factor and an axis label for display (default SI).
     """
+    plt = _pyplot()
     n = len(result.names)
     scales = np.ones(n) if scales is None else np.asarray(scales, dtype=float)
     labels = list(result.names) if labels is None else list(labels)
