@@ -156,6 +156,8 @@ def plot_optimisation_history(result, path: str | Path, scales=None, labels=None
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle(f"Optimisation: {result.message}", fontsize=9)
+    fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=100)
+    plt.close(fig)
     return path
