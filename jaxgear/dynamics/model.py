@@ -106,9 +106,15 @@ class DynamicsOptions(eqx.Module):
             contact loss). Static.
         backlash_width: corner width w of the smooth backlash, m (default 0.1 µm, 0.3 % of the static
             mesh deflection of the paper's pair at 700 N m).
-        steps_per_period: fixed steps of the Runge-Kutta solver per mesh period. Static. The default 128
-            Tsit5 steps keep the DTE RMS within 1e-6 relative of a 4× finer solve over 500-4200 rpm
-            (benchmarks/dynamics.py prints the check).
+        steps_per_period: least number of fixed Runge-Kutta steps per mesh period. Static. The
+            default 128 Tsit5 steps keep the DTE RMS of the paper's pair within ~1e-5 relative of a
+            1024-step solve over 500-4200 rpm (benchmarks/dynamics.py prints the check).
+        steps_per_mode_period: least number of steps per period of the highest natural frequency
+            (at the largest mesh stiffness), so that low speeds, where one mesh period spans many
+            vibration periods, stay accurate and stable (traced; the step count is then
+            max(steps_per_period, steps_per_mode_period · f_max · Tm)).
+        max_steps_per_period: upper bound of that count (static); beyond it (speeds below ~2 rpm
+            for the paper's pair) the result is reported as not finite (status 2), never silently.
         newton_max_steps: Newton iterations on the periodicity condition for one speed. Static.
         newton_batch_steps: iterations for a whole batch of speeds together; members not converged
             by then are redone one at a time (transient decay, then ``newton_max_steps``). Static.
@@ -123,11 +129,13 @@ class DynamicsOptions(eqx.Module):
     backlash: str = eqx.field(static=True, default="exact")
     backlash_width: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1e-7)
     steps_per_period: int = eqx.field(static=True, default=128)
+    steps_per_mode_period: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=16.0)
+    max_steps_per_period: int = eqx.field(static=True, default=65536)
     newton_max_steps: int = eqx.field(static=True, default=30)
     newton_batch_steps: int = eqx.field(static=True, default=8)
     newton_tol: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1e-9)
     solver: object = eqx.field(static=True, default=None)
-    transient_periods: int = eqx.field(static=True, default=60)
+    transient_periods: int = eqx.field(static=True, default=40)
     n_positions: int = eqx.field(static=True, default=64)
 
     def __check_init__(self):
@@ -254,6 +262,7 @@ class GearDynamics(eqx.Module):
     half_clearance: Float[Array, ""]
     torque: Float[Array, ""]
     mesh_period: Float[Array, ""]
+    step: Float[Array, ""]
     omega: Float[Array, "2"]
     tables: PeriodicSpline
     backlash_width: Float[Array, ""]
@@ -330,6 +339,11 @@ def build_dynamics(
     z1, z2 = pair.teeth
     omega1 = op.speed_rpm * (2.0 * jnp.pi / 60.0)
     b = pair.bearings
+    mesh_period = 2.0 * jnp.pi / (z1 * omega1)
+    f_max = _highest_natural_frequency(pair, rb, jnp.max(mesh.mesh_stiffness))
+    n_steps = jnp.maximum(
+        options.steps_per_period, jnp.ceil(options.steps_per_mode_period * f_max * mesh_period)
+    )
     return GearDynamics(
         base_radius=rb,
         inertia=pair.blank_inertia,
@@ -341,9 +355,21 @@ def build_dynamics(
         ct=b.ct,
         half_clearance=0.5 * pair.backlash,
         torque=op.torque,
-        mesh_period=2.0 * jnp.pi / (z1 * omega1),
+        mesh_period=mesh_period,
+        step=1.0 / n_steps,
         omega=jnp.stack([omega1, omega1 * z1 / z2]),
         tables=PeriodicSpline(interface_channels(mesh, interface)),
         backlash_width=options.backlash_width,
         backlash=options.backlash,
     )
+
+
+def _highest_natural_frequency(pair, rb, km):
+    """Largest undamped natural frequency (Hz) of the linearised model at mesh stiffness km."""
+    m, j, b = pair.blank_mass, pair.blank_inertia, pair.bearings
+    mass = jnp.stack([j[0], m[0], m[0], j[1], m[1], m[1]])
+    g = jnp.stack([rb[0], 1.0, 0.0, -rb[1], -1.0, 0.0])
+    k = km * jnp.outer(g, g) + jnp.diag(jnp.stack([0.0, b.ky[0], b.kx[0], 0.0, b.ky[1], b.kx[1]]))
+    s = 1.0 / jnp.sqrt(mass)
+    lam = jnp.linalg.eigvalsh(k * s[:, None] * s[None, :])
+    return jnp.sqrt(jnp.max(lam)) / (2.0 * jnp.pi)

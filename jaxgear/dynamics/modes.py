@@ -56,7 +56,9 @@ def mode_shapes(pair, mesh_stiffness) -> Modes:
     omega = jnp.sqrt(jnp.clip(lam, 0.0))
     mesh_energy = km * (g @ shapes) ** 2
     total = jnp.einsum("im,ij,jm->m", shapes, stiffness, shapes)
-    frac = jnp.where(total > 0, mesh_energy / jnp.where(total > 0, total, 1.0), 0.0)
+    # The rigid-body mode stores no strain energy: its fraction is 0, not round-off over round-off.
+    elastic = total > 1e-9 * jnp.max(total)
+    frac = jnp.where(elastic, mesh_energy / jnp.where(elastic, total, 1.0), 0.0)
     return Modes(frequencies=omega / (2.0 * jnp.pi), shapes=shapes, mesh_energy_fraction=frac)
 
 

@@ -37,6 +37,9 @@ STATUS_NOT_CONVERGED = 1
 STATUS_NOT_FINITE = 2
 STATUS_UNSTABLE = 3
 
+#: Members redone together by the fallback (fixed gather size).
+FALLBACK_CHUNK = 16
+
 #: Floquet multipliers up to 1 + this count as stable (the free rigid rotation has exactly 1).
 STABILITY_TOL = 1e-6
 
@@ -96,22 +99,24 @@ def _solver(options: DynamicsOptions):
 
 def _integrate(dyn: GearDynamics, z0, s, options: DynamicsOptions, ts=None):
     """One mesh period from z0; returns z(1) or z at the fractions ``ts``."""
-    n = options.steps_per_period
     saveat = diffrax.SaveAt(t1=True) if ts is None else diffrax.SaveAt(ts=ts)
     sol = diffrax.diffeqsolve(
         diffrax.ODETerm(dyn),
         _solver(options),
         t0=0.0,
         t1=1.0,
-        dt0=1.0 / n,
+        dt0=dyn.step,
         y0=z0,
         args=s,
         stepsize_controller=diffrax.ConstantStepSize(),
         saveat=saveat,
-        max_steps=n + 2,
+        max_steps=options.max_steps_per_period + 2,
         adjoint=diffrax.ForwardMode(),
+        throw=False,
     )
-    return sol.ys[-1] if ts is None else sol.ys
+    ok = sol.result == diffrax.RESULTS.successful
+    ys = jnp.where(ok, sol.ys, jnp.nan)  # too many steps needed: reported as not finite
+    return ys[-1] if ts is None else ys
 
 
 def _residual(dyn: GearDynamics, w, options: DynamicsOptions):
@@ -219,21 +224,21 @@ def _batch_solve_newton(dyns, w0, options: DynamicsOptions, max_steps: int):
 def _transient(dyn: GearDynamics, w, options: DynamicsOptions):
     """Integrate ``options.transient_periods`` mesh periods from w (transients decay), re-gauged."""
     n = options.transient_periods
-    steps = options.steps_per_period * n
     sol = diffrax.diffeqsolve(
         diffrax.ODETerm(dyn),
         _solver(options),
         t0=0.0,
         t1=float(n),
-        dt0=1.0 / options.steps_per_period,
+        dt0=dyn.step,
         y0=w[:12],
         args=w[12],
         stepsize_controller=diffrax.ConstantStepSize(),
         saveat=diffrax.SaveAt(t1=True),
-        max_steps=steps + 2,
+        max_steps=(options.max_steps_per_period + 2) * n,
         adjoint=diffrax.ForwardMode(),
+        throw=False,
     )
-    z = sol.ys[-1]
+    z = jnp.where(sol.result == diffrax.RESULTS.successful, sol.ys[-1], jnp.nan)
     rigid = 0.5 * (z[0] + z[3])
     z = z.at[0].add(-rigid).at[3].add(-rigid)
     return jnp.concatenate([z, w[12:]])
@@ -248,12 +253,14 @@ def _index(tree, i):
     return jax.tree_util.tree_map(lambda a: a[i], tree)
 
 
-def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None):
+def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None, retry_unstable=True):
     """Batched periodic orbits with a per-member fallback and implicit differentiation.
 
-    Members whose Newton fails or ends on an unstable orbit are redone one at a time (a loop with a
-    scalar ``lax.cond``, so it costs nothing when unused): transients are let decay from
+    Members whose Newton fails or ends on an unstable orbit are redone, gathered in chunks (a loop
+    with a scalar predicate, so it costs nothing when unused): transients are let decay from
     ``fallback_from`` (default ``w0``) for ``options.transient_periods`` periods, then Newton again.
+    ``retry_unstable`` (traced bool) = False redoes only members whose Newton failed, not those that
+    converged to an unstable orbit (a continuation inside a band without a stable orbit).
     The result is then passed through ``lax.custom_root`` per member, so derivatives come from the
     implicit function theorem on R = 0 and never from the iterations.
     """
@@ -266,27 +273,36 @@ def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None):
     )
     start = w0 if fallback_from is None else fallback_from
     start = jax.lax.stop_gradient(start)
+    bsz = w.shape[0]
+    chunk = min(bsz, FALLBACK_CHUNK)
 
-    def redo(i, carry):
-        w, aux = carry
-        ok = _acceptable(_index(aux, i))
+    # Redo the members that need it in chunks of up to ``chunk`` (gathered with a fixed size, so the
+    # cost scales with the number of failures, not with the batch): transient decay, then Newton.
+    def pending(carry):
+        _, aux, tried = carry
+        need = ~aux[2] | (retry_unstable & ~jax.vmap(_acceptable)(aux))
+        return need & ~tried
 
-        def again():
-            dyn_i = _index(dyns_c, i)
-            w_t = _transient(dyn_i, start[i], options)
-            dyn_1 = jax.tree_util.tree_map(lambda a: a[None], dyn_i)
-            w1, aux1 = _batch_solve_newton(dyn_1, w_t[None], options, options.newton_max_steps)
-            # keep the new attempt only if it is better (acceptable, or at least converged)
-            better = _acceptable(_index(aux1, 0)) | (aux1[2][0] & ~aux[2][i])
-            w_new = jnp.where(better, w1[0], w[i])
-            aux_new = jax.tree_util.tree_map(
-                lambda a, b: a.at[i].set(jnp.where(better, b[0], a[i])), aux, aux1
-            )
-            return w.at[i].set(w_new), aux_new
+    def cond(carry):
+        return jnp.any(pending(carry))
 
-        return jax.lax.cond(ok, lambda: (w, aux), again)
+    def body(carry):
+        w, aux, tried = carry
+        idx = jnp.nonzero(pending(carry), size=chunk, fill_value=bsz)[0]
+        valid = idx < bsz
+        safe = jnp.where(valid, idx, 0)
+        dyn_k = _index(dyns_c, safe)
+        w_t = jax.vmap(lambda d, x: _transient(d, x, options))(dyn_k, start[safe])
+        w1, aux1 = _batch_solve_newton(dyn_k, w_t, options, options.newton_max_steps)
+        # Keep a new attempt only if it is better: acceptable, or at least converged.
+        better = valid & (jax.vmap(_acceptable)(aux1) | (aux1[2] & ~aux[2][safe]))
+        tgt = jnp.where(better, safe, bsz)  # out-of-range index: dropped by the scatter
+        w = w.at[tgt].set(w1, mode="drop")
+        aux = jax.tree_util.tree_map(lambda a, b: a.at[tgt].set(b, mode="drop"), aux, aux1)
+        tried = tried.at[jnp.where(valid, safe, bsz)].set(True, mode="drop")
+        return w, aux, tried
 
-    w, aux = jax.lax.fori_loop(0, w.shape[0], redo, (w, aux))
+    w, aux, _ = jax.lax.while_loop(cond, body, (w, aux, jnp.zeros(bsz, bool)))
 
     def attach(dyn, w_star):
         def identity_solve(f, x):
@@ -386,6 +402,26 @@ def _check_inputs(pair, op):
         check_positive("blank_inertia", pair.blank_inertia, "kg m^2")
 
 
+def _canonical(tree):
+    """Floating leaves as strong-typed default-float arrays, so that equal shapes share one compiled
+    function whatever Python or weak types the caller used."""
+    ftype = jnp.result_type(float)
+
+    def conv(x):
+        if isinstance(x, float) or (eqx.is_array(x) and jnp.issubdtype(x.dtype, jnp.floating)):
+            return jnp.asarray(x, dtype=ftype)
+        return x
+
+    return jax.tree_util.tree_map(conv, tree)
+
+
+def _prepare(pair, op, mesh, interface, options):
+    if interface is None:
+        m = options.n_positions if mesh is None else mesh.n_positions
+        interface = MeshInterface.zeros(m)
+    return _canonical((pair, op, mesh, interface, options))
+
+
 def _mesh_and_interface(pair, op, mesh, interface, options):
     if mesh is None:
         from ..gear.mesh import mesh_cycle  # provided by the gear-mesh issue
@@ -439,6 +475,7 @@ def dynamic_response(
     _check_inputs(pair, op)
     # NaN marks "no guess" so that passing a guess or not shares one compiled function.
     guess = jnp.full(13, jnp.nan) if initial_state is None else jnp.asarray(initial_state, float)
+    pair, op, mesh, interface, options = _prepare(pair, op, mesh, interface, options)
     return _dynamic_response_jit(pair, op, mesh, interface, options, guess)
 
 
@@ -474,7 +511,7 @@ def _sweep_continuation(pair, op, speeds, mesh, interface, options):
     mesh, interface = _mesh_and_interface(pair, op, mesh, interface, options)
 
     def step(carry, speed):
-        w_prev, speed_prev, have_prev = carry
+        w_prev, speed_prev, have_prev, prev_stable = carry
         op_n = _at_speed(op, speed)
         dyn = build_dynamics(pair, op_n, mesh, interface, options)
         cold = static_guess(dyn)
@@ -483,14 +520,23 @@ def _sweep_continuation(pair, op, speeds, mesh, interface, options):
         # unstable orbit is left), the state left by the previous speed decays to the new attractor:
         # this is the jump.
         batch = jax.tree_util.tree_map(lambda a: a[None], dyn)
-        w, aux = _batch_solve(batch, guess[None], options)
+        # Inside a band where the previous speed had no stable orbit either, an unstable orbit is
+        # accepted without the (costly, futile) transient retry.
+        w, aux = _batch_solve(batch, guess[None], options, retry_unstable=~have_prev | prev_stable)
         w, aux = w[0], _index(aux, 0)
         res = _postprocess(dyn, mesh, op_n, w, aux, options)
-        ok = res.converged
-        new_carry = (jnp.where(ok, w, w_prev), jnp.where(ok, speed, speed_prev), have_prev | ok)
+        # Carry only stable orbits: an unstable one (inside a band without a stable periodic orbit)
+        # is not what the gears settle on and may sit far from it.
+        ok = res.converged & res.stable
+        new_carry = (
+            jnp.where(ok, w, w_prev),
+            jnp.where(ok, speed, speed_prev),
+            have_prev | ok,
+            res.stable | ~res.converged,
+        )
         return new_carry, res
 
-    init = (jnp.zeros(13), speeds[0], jnp.asarray(False))
+    init = (jnp.zeros(13), speeds[0], jnp.asarray(False), jnp.asarray(True))
     _, out = jax.lax.scan(step, init, speeds)
     return out
 
@@ -524,6 +570,7 @@ def dynamic_response_sweep(
         raise ValueError(f"speeds_rpm must be a non-empty 1-D array; got shape {speeds.shape}")
     check_positive("speeds_rpm", speeds, "rpm")
     _check_inputs(pair, op)
+    pair, op, mesh, interface, options = _prepare(pair, op, mesh, interface, options)
     if mode == "parallel":
         return _sweep_parallel(pair, op, speeds, mesh, interface, options)
     if mode == "continuation":
