@@ -276,33 +276,58 @@ def _batch_solve(dyns, w0, options: DynamicsOptions, fallback_from=None, retry_u
     bsz = w.shape[0]
     chunk = min(bsz, FALLBACK_CHUNK)
 
-    # Redo the members that need it in chunks of up to ``chunk`` (gathered with a fixed size, so the
-    # cost scales with the number of failures, not with the batch): transient decay, then Newton.
-    def pending(carry):
-        _, aux, tried = carry
-        need = ~aux[2] | (retry_unstable & ~jax.vmap(_acceptable)(aux))
-        return need & ~tried
+    if bsz <= 2:
+        # Few members (one speed, continuation): redo them one at a time with a scalar cond. (The
+        # gathered-chunk loop below costs ~0.1 s per call on CPU even when it does not iterate.)
+        def redo(i, carry):
+            w, aux = carry
+            aux_i = _index(aux, i)
+            ok = aux_i[2] & (~retry_unstable | _acceptable(aux_i))
 
-    def cond(carry):
-        return jnp.any(pending(carry))
+            def again():
+                dyn_i = _index(dyns_c, i)
+                w_t = _transient(dyn_i, start[i], options)
+                dyn_1 = jax.tree_util.tree_map(lambda a: a[None], dyn_i)
+                w1, aux1 = _batch_solve_newton(dyn_1, w_t[None], options, options.newton_max_steps)
+                # keep the new attempt only if it is better (acceptable, or at least converged)
+                better = _acceptable(_index(aux1, 0)) | (aux1[2][0] & ~aux[2][i])
+                w_new = jnp.where(better, w1[0], w[i])
+                aux_new = jax.tree_util.tree_map(
+                    lambda a, b: a.at[i].set(jnp.where(better, b[0], a[i])), aux, aux1
+                )
+                return w.at[i].set(w_new), aux_new
 
-    def body(carry):
-        w, aux, tried = carry
-        idx = jnp.nonzero(pending(carry), size=chunk, fill_value=bsz)[0]
-        valid = idx < bsz
-        safe = jnp.where(valid, idx, 0)
-        dyn_k = _index(dyns_c, safe)
-        w_t = jax.vmap(lambda d, x: _transient(d, x, options))(dyn_k, start[safe])
-        w1, aux1 = _batch_solve_newton(dyn_k, w_t, options, options.newton_max_steps)
-        # Keep a new attempt only if it is better: acceptable, or at least converged.
-        better = valid & (jax.vmap(_acceptable)(aux1) | (aux1[2] & ~aux[2][safe]))
-        tgt = jnp.where(better, safe, bsz)  # out-of-range index: dropped by the scatter
-        w = w.at[tgt].set(w1, mode="drop")
-        aux = jax.tree_util.tree_map(lambda a, b: a.at[tgt].set(b, mode="drop"), aux, aux1)
-        tried = tried.at[jnp.where(valid, safe, bsz)].set(True, mode="drop")
-        return w, aux, tried
+            return jax.lax.cond(ok, lambda: (w, aux), again)
 
-    w, aux, _ = jax.lax.while_loop(cond, body, (w, aux, jnp.zeros(bsz, bool)))
+        w, aux = jax.lax.fori_loop(0, bsz, redo, (w, aux))
+    else:
+        # Redo the members that need it in chunks of up to ``chunk`` (gathered with a fixed size, so the
+        # cost scales with the number of failures, not with the batch): transient decay, then Newton.
+        def pending(carry):
+            _, aux, tried = carry
+            need = ~aux[2] | (retry_unstable & ~jax.vmap(_acceptable)(aux))
+            return need & ~tried
+
+        def cond(carry):
+            return jnp.any(pending(carry))
+
+        def body(carry):
+            w, aux, tried = carry
+            idx = jnp.nonzero(pending(carry), size=chunk, fill_value=bsz)[0]
+            valid = idx < bsz
+            safe = jnp.where(valid, idx, 0)
+            dyn_k = _index(dyns_c, safe)
+            w_t = jax.vmap(lambda d, x: _transient(d, x, options))(dyn_k, start[safe])
+            w1, aux1 = _batch_solve_newton(dyn_k, w_t, options, options.newton_max_steps)
+            # Keep a new attempt only if it is better: acceptable, or at least converged.
+            better = valid & (jax.vmap(_acceptable)(aux1) | (aux1[2] & ~aux[2][safe]))
+            tgt = jnp.where(better, safe, bsz)  # out-of-range index: dropped by the scatter
+            w = w.at[tgt].set(w1, mode="drop")
+            aux = jax.tree_util.tree_map(lambda a, b: a.at[tgt].set(b, mode="drop"), aux, aux1)
+            tried = tried.at[jnp.where(valid, safe, bsz)].set(True, mode="drop")
+            return w, aux, tried
+
+        w, aux, _ = jax.lax.while_loop(cond, body, (w, aux, jnp.zeros(bsz, bool)))
 
     def attach(dyn, w_star):
         def identity_solve(f, x):
