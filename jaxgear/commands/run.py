@@ -115,7 +115,13 @@ def run(args: argparse.Namespace) -> int:
         f"wrote {out / 'sweep.csv'}, {out / 'summary.json'}, dte_rms.png, power_loss.png, "
         f"efficiency.png in {out}"
     )
-    return 0 if summary["headline"]["points_not_converged"] == 0 else 1
+    bad = summary["headline"]["points_not_converged"]
+    if bad:
+        print(
+            f"{bad} of {len(speeds)} speeds did not converge (kept, flagged in sweep.csv and "
+            "summary.json: e.g. no stable periodic orbit where the teeth rattle)"
+        )
+    return 0
 
 
 def _default_pair(jg):
