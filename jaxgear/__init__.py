@@ -29,6 +29,7 @@ from .dynamics import dynamic_response as dynamic_response
 from .dynamics import dynamic_response_sweep as dynamic_response_sweep
 from .dynamics import mode_shapes as mode_shapes
 from .dynamics import natural_frequencies as natural_frequencies
+from .fidelity import Fidelity as Fidelity
 from .lubrication import thermal as thermal
 from .lubrication.ehl import EHLModel as EHLModel
 from .lubrication.ehl import EHLSolution as EHLSolution
@@ -40,3 +41,12 @@ from .lubrication.friction_models import XuFriction as XuFriction
 from .lubrication.lubricant import Lubricant as Lubricant
 from .lubrication.roughness import Surfaces as Surfaces
 from .operating import OperatingPoint as OperatingPoint
+from .optimise import OptimisationResult as OptimisationResult
+from .optimise import optimise as optimise_bounded
+from .optimise import optimise_roughness_scale as optimise_roughness_scale
+from .optimise import optimise_tip_relief as optimise_tip_relief
+from .optimise import optimise_torque as optimise_torque
+from .sweep import SweepResult as SweepResult
+from .sweep import sweep as sweep
+from .tribodynamics import SimulationResult as SimulationResult
+from .tribodynamics import simulate as simulate

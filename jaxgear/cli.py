@@ -12,7 +12,7 @@ import importlib
 import sys
 
 # Subcommand modules, in the order shown by --help.
-COMMANDS = ("mesh", "ehl")
+COMMANDS = ("run", "mesh", "ehl", "optimise")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -36,6 +36,25 @@ def enable_float64() -> None:
     jax.config.update("jax_enable_x64", True)
 
 
+def enable_compilation_cache() -> None:
+    """Keep compiled programs on disk (``$JAXGEAR_CACHE_DIR``, default ~/.cache/jaxgear/xla), so a
+    second ``jaxgear run`` skips most of the compilation. Set JAXGEAR_CACHE_DIR=off to disable."""
+    import os
+    from pathlib import Path
+
+    import jax
+
+    where = os.environ.get("JAXGEAR_CACHE_DIR", str(Path.home() / ".cache" / "jaxgear" / "xla"))
+    if where.lower() in ("off", "none", ""):
+        return
+    try:
+        Path(where).mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return  # read-only home: run without the cache
+    jax.config.update("jax_compilation_cache_dir", where)
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -43,6 +62,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 0
     enable_float64()
+    enable_compilation_cache()
     try:
         return int(args.func(args) or 0)
     except ValueError as err:

@@ -68,3 +68,96 @@ def plot_mesh_cycle(mesh, path: str | Path) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def _paper_points(ax, ymax=None):
+    """Mark the paper's resonance speeds (1750 and 3500 rpm, REFERENCE §7 R1)."""
+    for rpm in (1750.0, 3500.0):
+        ax.axvline(rpm, color="0.7", lw=0.8, ls=":")
+
+
+def plot_dte_rms(speeds_rpm, dte_rms, path, *, label="tribo-dynamic", others=()):
+    """RMS dynamic transmission error (first 10 mesh harmonics) against speed, like the paper's Fig. 3."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(speeds_rpm, np.asarray(dte_rms) * 1e6, ".-", ms=3, label=label)
+    for other_label, values in others:
+        ax.plot(speeds_rpm, np.asarray(values) * 1e6, "--", label=other_label)
+    _paper_points(ax)
+    ax.set(xlabel="gear 1 speed (rpm)", ylabel="(εd)rms (µm)", title="Dynamic transmission error")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def plot_power_loss(speeds_rpm, dynamic, quasi_static, path):
+    """Cycle-mean power loss against speed: sliding, rolling and total, tribo-dynamic against
+    quasi-static (like the paper's Fig. 4a). ``dynamic``/``quasi_static``: dicts with keys
+    "total", "sliding", "rolling" (W)."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    styles = {"total": "-", "sliding": "--", "rolling": ":"}
+    for key, ls in styles.items():
+        ax.plot(speeds_rpm, dynamic[key], ls, color="C0", label=f"{key}, tribo-dynamic")
+        ax.plot(speeds_rpm, quasi_static[key], ls, color="C1", label=f"{key}, quasi-static")
+    _paper_points(ax)
+    ax.set(xlabel="gear 1 speed (rpm)", ylabel="Φ̄ (W)", title="Mesh power loss")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def plot_efficiency(speeds_rpm, dynamic, quasi_static, path):
+    """Mesh efficiency Ψ (%) against speed, tribo-dynamic against quasi-static (paper's Fig. 4b)."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(speeds_rpm, 100 * np.asarray(dynamic), "-", label="tribo-dynamic")
+    ax.plot(speeds_rpm, 100 * np.asarray(quasi_static), "--", label="quasi-static")
+    _paper_points(ax)
+    ax.set(xlabel="gear 1 speed (rpm)", ylabel="Ψ (%)", title="Mesh efficiency")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def plot_optimisation_history(result, path: str | Path, scales=None, labels=None) -> Path:
+    """Objective, parameters and projected gradient norm against optimiser step (PNG).
+
+    ``scales``/``labels``: per parameter, a factor and an axis label for display (default SI).
+    """
+    plt = _pyplot()
+    n = len(result.names)
+    scales = np.ones(n) if scales is None else np.asarray(scales, dtype=float)
+    labels = list(result.names) if labels is None else list(labels)
+    steps = np.arange(len(result.history_objective))
+    fig, axes = plt.subplots(1, 2 + n, figsize=(4.2 * (2 + n), 3.6))
+    axes[0].plot(steps, 100.0 * np.asarray(result.history_objective), ".-")
+    axes[0].axhline(100.0 * result.objective, color="k", lw=0.8, ls="--", label="optimum")
+    axes[0].set(xlabel="step", ylabel="mean efficiency (%)", title="Objective")
+    axes[0].legend()
+    for i in range(n):
+        ax = axes[1 + i]
+        ax.plot(steps, np.asarray(result.history_x)[:, i] * scales[i], ".-")
+        for bound in (result.lower[i], result.upper[i]):
+            ax.axhline(bound * scales[i], color="grey", lw=0.8, ls=":")
+        ax.set(xlabel="step", ylabel=labels[i], title=labels[i])
+    gn = np.asarray(result.history_gradient_norm)
+    axes[-1].semilogy(steps, np.where(gn > 0, gn, np.nan), ".-")
+    axes[-1].set(xlabel="step", ylabel="projected gradient norm", title="Stationarity")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"Optimisation: {result.message}", fontsize=9)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path

@@ -291,7 +291,7 @@ def run_continuation(
 
     carry = carry0
     carry_treedef = jax.tree_util.tree_structure(carry0)
-    first = _slice(inputs, 0, min(chunk, n))
+    first = _slice(inputs, 0, min(chunk, n), pad_to=chunk)
     out_struct = jax.eval_shape(scan_chunk, carry0, first)[1]
     treedef = jax.tree_util.tree_structure(out_struct)
     pieces, statuses, messages = [], [], []
@@ -307,8 +307,11 @@ def run_continuation(
             out, status, carry = loaded
         else:
             try:
-                carry, out = jax.block_until_ready(scan_chunk(carry, _slice(inputs, lo, hi)))
-                out = jax.tree_util.tree_map(np.asarray, out)
+                # The last chunk is padded by repeating its final point (one compiled shape; the
+                # repeats leave the carry at that point's converged state) and the extra rows dropped.
+                xs = _slice(inputs, lo, hi, pad_to=chunk)
+                carry, out = jax.block_until_ready(scan_chunk(carry, xs))
+                out = _slice(jax.tree_util.tree_map(np.asarray, out), 0, hi - lo)
                 status = _status_from(out, hi - lo, converged_key)
                 _store(ckpt, index, out, status, carry)
             except Exception as err:  # noqa: BLE001

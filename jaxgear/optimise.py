@@ -1,0 +1,702 @@
+"""Design optimisation with optax: tip relief, torque and roughness scale for efficiency.
+
+One generic bounded optimiser, ``optimise(objective, x0, bounds)``, maximises a scalar objective of a
+few design parameters; ``optimise_tip_relief``, ``optimise_torque`` and ``optimise_roughness_scale``
+build the objective (the mean efficiency over a set of speeds) and call it.
+
+Numerics:
+
+- **Scaling.** The optimiser works on the unit box u = (x − lo)/(hi − lo) ∈ [0, 1]ⁿ, so a relief amount
+  (tens of µm) and a start roll angle (a few degrees) move on comparable scales whatever their SI units.
+  The objective is divided by the largest |∂f/∂u| at the start, so the first gradient has unit size
+  (Adam does not care; plain SGD then has a meaningful learning rate).
+- **Bounds by projection.** After each optax update, u is clipped to [0, 1] (projected gradient
+  ascent). A bound is reached exactly, which matters here: on the quasi-static rung the efficiency
+  rises monotonically with relief amount, so the amount optimum is on its bound, where a sigmoid
+  reparametrisation would only creep towards it with a vanishing gradient.
+- **Gradients in forward mode** (``jax.jacfwd``: two to four parameters, and ``simulate`` is
+  differentiable in forward mode only, because the periodic-orbit solver has a custom JVP rule). The
+  value, gradient and convergence flag of each step come from one jitted call.
+- **Stationarity** is measured by the projected gradient g_p = P(u + g) − u (P the clip to the box; g
+  the gradient in box units): zero at an interior optimum and at an optimum on a bound. The run counts
+  as converged when |g_p| ≤ ``gtol`` · |g_p at the start|.
+- **Non-converged simulations are never used.** The objective returns, beside its value, whether every
+  simulate point converged. A step that lands on a non-converged point is rejected and the run stops,
+  returning the best converged point with status ``STATUS_SIMULATION``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from collections.abc import Callable, Sequence
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+from jaxtyping import Array, Float
+
+from ._validation import check_choice
+from .fidelity import Fidelity
+from .gear.geometry import gear_geometry
+from .gear.pair import RELIEF_SHAPES, GearPair, TipRelief
+from .operating import OperatingPoint
+from .tribodynamics import simulate_with_state
+
+# Status codes of an optimisation.
+STATUS_CONVERGED = 0  # projected gradient below tolerance
+STATUS_MAX_STEPS = 1  # step cap reached before the gradient tolerance
+STATUS_SIMULATION = 2  # a step landed on a non-converged simulation point: stopped there
+STATUS_START = 3  # the start point itself did not converge: nothing done
+STATUS_NON_FINITE = 4  # non-finite objective or gradient
+STATUS_NAMES = {
+    STATUS_CONVERGED: "converged (projected gradient below tolerance)",
+    STATUS_MAX_STEPS: "step cap reached before the gradient tolerance",
+    STATUS_SIMULATION: "stopped: a simulation point did not converge (best converged point kept)",
+    STATUS_START: "the start point did not converge; nothing optimised",
+    STATUS_NON_FINITE: "stopped: non-finite objective or gradient (best finite point kept)",
+}
+
+DEFAULT_RELIEF_AMOUNT_BOUNDS = (0.0, 50e-6)  # m
+DEFAULT_START_MARGIN = 0.05  # fraction of each gear's roll-angle range kept clear at both ends
+DEFAULT_ROUGHNESS_BOUNDS = (0.1, 3.0)
+
+
+class OptimisationResult(eqx.Module):
+    """Result of a bounded design optimisation (SI units throughout).
+
+    Attributes:
+        names: parameter names, e.g. ("tip_relief_amount", "tip_relief_start_roll_angle").
+        x: optimum parameters (the best converged point seen), SI [n].
+        x_start: start parameters (clipped into the bounds), SI [n].
+        lower, upper: the bounds, SI [n].
+        objective: objective (mean efficiency) at the optimum.
+        objective_start: objective at the start.
+        gradient: ∂objective/∂x at the optimum, per SI unit of each parameter [n].
+        gradient_start: ∂objective/∂x at the start, per SI unit [n] (e.g. the efficiency gain per unit
+            roughness scale).
+        gradient_norm: norm of the projected gradient at the last accepted iterate, in objective units
+            per box width (dimensionless box variables u = (x − lo)/(hi − lo)).
+        history_objective: objective per accepted iterate [k + 1] (entry 0 = start).
+        history_x: parameters per accepted iterate, SI [k + 1, n].
+        history_gradient: ∂objective/∂x per accepted iterate, SI [k + 1, n] (what the optimiser used).
+        history_gradient_norm: projected gradient norm per accepted iterate [k + 1].
+        steps: optimiser steps taken (accepted).
+        converged: status == STATUS_CONVERGED.
+        status: see ``STATUS_NAMES``.
+        pair, surfaces, op: the inputs with the optimum substituted (GearPair, Surfaces,
+            OperatingPoint).
+        fidelity: the Fidelity used.
+    """
+
+    names: tuple[str, ...] = eqx.field(static=True)
+    x: np.ndarray
+    x_start: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    objective: float
+    objective_start: float
+    gradient: np.ndarray
+    gradient_start: np.ndarray
+    gradient_norm: float
+    history_objective: np.ndarray
+    history_x: np.ndarray
+    history_gradient: np.ndarray
+    history_gradient_norm: np.ndarray
+    steps: int
+    status: int
+    pair: GearPair | None = None
+    surfaces: object = None
+    op: OperatingPoint | None = None
+    fidelity: Fidelity | None = None
+
+    @property
+    def converged(self) -> bool:
+        return self.status == STATUS_CONVERGED
+
+    @property
+    def message(self) -> str:
+        return STATUS_NAMES[self.status]
+
+    def value(self, name: str) -> np.ndarray:
+        """Optimum value(s) of a parameter by name (SI), e.g. ``result.value("tip_relief_amount")``.
+
+        Parameters optimised per gear ("…_1", "…_2") are returned as a pair."""
+        if name in self.names:
+            return np.asarray(self.x[self.names.index(name)])
+        per_gear = [f"{name}_1", f"{name}_2"]
+        if all(n in self.names for n in per_gear):
+            return np.asarray([self.x[self.names.index(n)] for n in per_gear])
+        raise ValueError(f"no parameter {name!r}; parameters: {', '.join(self.names)}")
+
+    @property
+    def amount(self) -> np.ndarray:
+        """Optimum tip relief amount per gear, m (2,) (tip relief optimisations)."""
+        if self.pair is None:
+            raise ValueError("this optimisation has no gear pair")
+        return np.asarray(self.pair.tip_relief.amount)
+
+    @property
+    def start_roll_angle(self) -> np.ndarray:
+        """Optimum relief start roll angle per gear, rad (2,) (tip relief optimisations)."""
+        if self.pair is None:
+            raise ValueError("this optimisation has no gear pair")
+        return np.asarray(self.pair.tip_relief.start_roll_angle)
+
+    @property
+    def shape(self) -> tuple[str, str]:
+        """Relief shape per gear of the optimum pair."""
+        if self.pair is None:
+            raise ValueError("this optimisation has no gear pair")
+        return self.pair.tip_relief.shape
+
+
+# ---------------------------------------------------------------------------------------------------
+# The generic bounded optimiser
+# ---------------------------------------------------------------------------------------------------
+
+
+@functools.lru_cache(maxsize=32)
+def default_optimiser(learning_rate: float, steps: int) -> optax.GradientTransformation:
+    """Adam with a cosine-decayed learning rate (in box units per step), as used by default."""
+    schedule = optax.cosine_decay_schedule(learning_rate, max(steps, 1), alpha=0.02)
+    return optax.adam(schedule, b2=0.99)
+
+
+@eqx.filter_jit
+def _value_and_gradient(objective, x):
+    """Objective value, ∂/∂x (forward mode) and the convergence flag, at x (SI)."""
+
+    def fn(x):
+        value, ok = objective(x)
+        return value, (value, ok)
+
+    grad, (value, ok) = jax.jacfwd(fn, has_aux=True)(x)
+    return value, grad, ok
+
+
+def value_and_gradient(objective, x) -> tuple[Array, Array, Array]:
+    """The value, forward-mode gradient (per SI unit of x) and convergence flag the optimiser uses."""
+    return _value_and_gradient(objective, jnp.asarray(x, dtype=float))
+
+
+def _check_steps(steps):
+    if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 0:
+        raise ValueError(f"steps = {steps!r} is out of range; valid range: integer >= 0")
+
+
+def _check_positive_float(name, value):
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | float)
+        or not math.isfinite(value)
+        or value <= 0
+    ):
+        raise ValueError(f"{name} = {value!r} is out of range; valid range: (0, inf)")
+
+
+def _check_bounds(names, lower, upper, units):
+    for name, lo, hi, unit in zip(names, lower, upper, units):
+        if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
+            raise ValueError(
+                f"bounds of {name} = ({lo:g}, {hi:g}) {unit} are invalid; need finite lower < upper"
+            )
+
+
+def optimise(
+    objective: Callable,
+    x0,
+    bounds: tuple[Sequence[float], Sequence[float]],
+    *,
+    steps: int = 40,
+    learning_rate: float = 0.1,
+    optimiser: optax.GradientTransformation | None = None,
+    gtol: float = 1e-2,
+    names: Sequence[str] | None = None,
+) -> OptimisationResult:
+    """Maximise ``objective`` over a box by projected optax steps on the unit box.
+
+    Args:
+        objective: x (SI, [n]) → (value, ok): a scalar to maximise and a boolean that is True when the
+            value may be trusted (every simulation converged). Traceable; differentiated with
+            ``jax.jacfwd``. An ``eqx.Module`` objective keeps its arrays traced, so a second call with
+            new values does not recompile.
+        x0: start, SI [n]; clipped into the bounds.
+        bounds: (lower [n], upper [n]), SI, finite, lower < upper.
+        steps: optimiser step cap (≥ 0; 0 evaluates the start only).
+        learning_rate: of the default optimiser, in box widths per step (Adam with b2 = 0.99 so
+            late steps are not throttled by the large early gradients; cosine-decayed to 2 %).
+        optimiser: any optax GradientTransformation (minimising; it sees the negated, normalised
+            objective in box units). Overrides ``learning_rate``.
+        gtol: converged when the projected gradient norm is ≤ gtol × its value at the start.
+        names: parameter names (default "x0", "x1", ...).
+
+    Returns:
+        OptimisationResult (without pair/surfaces/op: the wrappers fill those in).
+    """
+    _check_steps(steps)
+    _check_positive_float("learning_rate", learning_rate)
+    _check_positive_float("gtol", gtol)
+    x0 = np.atleast_1d(np.asarray(x0, dtype=float))
+    lower = np.atleast_1d(np.asarray(bounds[0], dtype=float))
+    upper = np.atleast_1d(np.asarray(bounds[1], dtype=float))
+    n = x0.size
+    names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(n))
+    if lower.shape != (n,) or upper.shape != (n,) or len(names) != n:
+        raise ValueError(
+            f"bounds and names need {n} entries (one per parameter); got {lower.size}, "
+            f"{upper.size} and {len(names)}"
+        )
+    if not np.all(np.isfinite(x0)):
+        raise ValueError(f"x0 = {x0} is not finite")
+    _check_bounds(names, lower, upper, [""] * n)
+    width = upper - lower
+    x0 = np.clip(x0, lower, upper)
+    opt = optimiser if optimiser is not None else default_optimiser(float(learning_rate), steps)
+
+    def evaluate(u):
+        x = lower + width * u
+        value, grad, ok = _value_and_gradient(objective, jnp.asarray(x))
+        value, grad = float(value), np.asarray(grad, dtype=float)
+        finite = math.isfinite(value) and bool(np.all(np.isfinite(grad)))
+        return x, value, grad, bool(ok), finite
+
+    def projected_norm(u, grad_u):
+        return float(np.linalg.norm(np.clip(u + grad_u, 0.0, 1.0) - u))
+
+    u = (x0 - lower) / width
+    x, value, grad, ok, finite = evaluate(u)
+    hist_f, hist_x, hist_g, hist_pg = [value], [x], [grad], []
+    if not ok or not finite:
+        status = STATUS_START if not ok else STATUS_NON_FINITE
+        hist_pg.append(float("nan"))
+        return _result(names, x, x0, lower, upper, value, value, grad, grad, hist_pg[-1],
+                       hist_f, hist_x, hist_g, hist_pg, 0, status)  # fmt: skip
+    grad_u = grad * width
+    pg0 = projected_norm(u, grad_u)
+    hist_pg.append(pg0)
+    # Normalise so the first gradient has unit max-abs size (box units); constant during the run.
+    scale = float(np.max(np.abs(grad_u)))
+    scale = scale if scale > 0 else 1.0
+    best = (value, x, grad, pg0)
+    state = opt.init(jnp.asarray(u))
+    status = STATUS_CONVERGED if pg0 == 0.0 else STATUS_MAX_STEPS
+    taken = 0
+    for _ in range(steps if status != STATUS_CONVERGED else 0):
+        updates, state = opt.update(jnp.asarray(-grad_u / scale), state, jnp.asarray(u))
+        u_new = np.clip(u + np.asarray(updates), 0.0, 1.0)
+        x_new, v_new, g_new, ok, finite = evaluate(u_new)
+        if not ok or not finite:
+            status = STATUS_SIMULATION if not ok else STATUS_NON_FINITE
+            break
+        taken += 1
+        u, grad_u = u_new, g_new * width
+        pg = projected_norm(u, grad_u)
+        hist_f.append(v_new), hist_x.append(x_new), hist_g.append(g_new), hist_pg.append(pg)
+        if v_new > best[0]:
+            best = (v_new, x_new, g_new, pg)
+        if pg <= gtol * pg0:
+            status = STATUS_CONVERGED
+            break
+    value_best, x_best, grad_best, _ = best
+    return _result(names, x_best, x0, lower, upper, value_best, hist_f[0], grad_best, hist_g[0],
+                   hist_pg[-1], hist_f, hist_x, hist_g, hist_pg, taken, status)  # fmt: skip
+
+
+def _result(names, x, x0, lower, upper, value, value0, grad, grad0, pg, hf, hx, hg, hpg, k, status):
+    return OptimisationResult(
+        names=tuple(names),
+        x=np.asarray(x, dtype=float),
+        x_start=np.asarray(x0, dtype=float),
+        lower=lower,
+        upper=upper,
+        objective=float(value),
+        objective_start=float(value0),
+        gradient=np.asarray(grad, dtype=float),
+        gradient_start=np.asarray(grad0, dtype=float),
+        gradient_norm=float(pg),
+        history_objective=np.asarray(hf, dtype=float),
+        history_x=np.asarray(hx, dtype=float),
+        history_gradient=np.asarray(hg, dtype=float),
+        history_gradient_norm=np.asarray(hpg, dtype=float),
+        steps=int(k),
+        status=int(status),
+    )
+
+
+# ---------------------------------------------------------------------------------------------------
+# Objectives: mean efficiency over speeds, with one design input substituted
+# ---------------------------------------------------------------------------------------------------
+
+
+def _mean_efficiency(pair, lubricant, surfaces, op, speeds, fidelity):
+    """Mean efficiency over ``speeds`` (rpm) and whether every point converged (vmapped)."""
+
+    def one(speed):
+        point = OperatingPoint(
+            torque=op.torque, speed_rpm=speed, inlet_temperature=op.inlet_temperature
+        )
+        result = simulate_with_state(pair, lubricant, surfaces, point, fidelity)[0]
+        return result.efficiency, result.converged
+
+    eff, ok = jax.vmap(one)(speeds)
+    return jnp.mean(eff), jnp.all(ok)
+
+
+def with_tip_relief(pair: GearPair, x, both_gears: bool) -> GearPair:
+    """``pair`` with relief parameters x substituted (traceable).
+
+    x = (amount m, start rad) for both gears, or (amount₁, amount₂, start₁, start₂) per gear."""
+    x = jnp.asarray(x)
+    if both_gears:
+        amount, start = jnp.stack([x[0], x[0]]), jnp.stack([x[1], x[1]])
+    else:
+        amount, start = x[0:2], x[2:4]
+    return eqx.tree_at(
+        lambda p: (p.tip_relief.amount, p.tip_relief.start_roll_angle), pair, (amount, start)
+    )
+
+
+class TipReliefObjective(eqx.Module):
+    """Mean efficiency over ``speeds_rpm`` as a function of the tip relief parameters (SI).
+
+    Call with x = (amount m, start roll angle rad) (``both_gears``) or
+    (amount₁, amount₂, start₁, start₂); returns (mean efficiency, every point converged)."""
+
+    pair: GearPair
+    lubricant: object
+    surfaces: object
+    op: OperatingPoint
+    speeds_rpm: Float[Array, " N"]
+    fidelity: Fidelity = eqx.field(static=True)
+    both_gears: bool = eqx.field(static=True)
+
+    def __call__(self, x):
+        pair = with_tip_relief(self.pair, x, self.both_gears)
+        return _mean_efficiency(
+            pair, self.lubricant, self.surfaces, self.op, self.speeds_rpm, self.fidelity
+        )
+
+
+class TorqueObjective(eqx.Module):
+    """Mean efficiency over ``speeds_rpm`` as a function of x = (gear 1 torque, N m)."""
+
+    pair: GearPair
+    lubricant: object
+    surfaces: object
+    op: OperatingPoint
+    speeds_rpm: Float[Array, " N"]
+    fidelity: Fidelity = eqx.field(static=True)
+
+    def __call__(self, x):
+        op = eqx.tree_at(lambda o: o.torque, self.op, jnp.asarray(x)[0])
+        return _mean_efficiency(
+            self.pair, self.lubricant, self.surfaces, op, self.speeds_rpm, self.fidelity
+        )
+
+
+class RoughnessScaleObjective(eqx.Module):
+    """Mean efficiency over ``speeds_rpm`` as a function of x = (roughness scale,)."""
+
+    pair: GearPair
+    lubricant: object
+    surfaces: object
+    op: OperatingPoint
+    speeds_rpm: Float[Array, " N"]
+    fidelity: Fidelity = eqx.field(static=True)
+
+    def __call__(self, x):
+        surfaces = eqx.tree_at(lambda s: s.scale, self.surfaces, jnp.asarray(x)[0])
+        return _mean_efficiency(
+            self.pair, self.lubricant, surfaces, self.op, self.speeds_rpm, self.fidelity
+        )
+
+
+def _speeds(speeds_rpm, op):
+    if speeds_rpm is None:
+        return jnp.reshape(jnp.asarray(op.speed_rpm, dtype=float), (1,))
+    arr = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
+    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ValueError(
+            f"speeds_rpm = {arr} is out of range; valid range: a non-empty list of finite speeds > 0 rpm"
+        )
+    return jnp.asarray(arr)
+
+
+def _common_checks(op, fidelity):
+    fidelity = Fidelity.fast() if fidelity is None else fidelity
+    if not isinstance(fidelity, Fidelity):
+        raise ValueError(f"fidelity must be a jaxgear.Fidelity; got {type(fidelity).__name__}")
+    if not isinstance(op, OperatingPoint):
+        raise ValueError(f"op must be a jaxgear.OperatingPoint; got {type(op).__name__}")
+    return fidelity
+
+
+def _pair_bounds(name, value, n_gears):
+    """(lo, hi) or per gear ((lo1, hi1), (lo2, hi2)) → arrays lo[2], hi[2]."""
+    arr = np.asarray(value, dtype=float)
+    if arr.shape == (2,):
+        arr = np.stack([arr, arr])
+    if arr.shape != (2, 2):
+        raise ValueError(
+            f"bounds[{name!r}] = {value!r} must be (lower, upper) or per gear "
+            "((lower₁, upper₁), (lower₂, upper₂))"
+        )
+    return arr[:, 0], arr[:, 1]
+
+
+def tip_relief_bounds(pair: GearPair, bounds: dict | None = None, margin=DEFAULT_START_MARGIN):
+    """Validated bounds of relief amount (m) and start roll angle (rad), per gear (arrays [2]).
+
+    Defaults: amount in [0, 50 µm]; start inside each gear's own path of contact (from its start of
+    active profile to its tip) less ``margin`` × that range at both ends (the relief must have a
+    length). Given start bounds must lie inside the gear's path of contact."""
+    bounds = {} if bounds is None else dict(bounds)
+    unknown = set(bounds) - {"amount", "start_roll_angle"}
+    if unknown:
+        raise ValueError(
+            f"unknown bounds key(s) {sorted(unknown)}; valid keys: 'amount', 'start_roll_angle'"
+        )
+    geo = gear_geometry(pair)
+    sap = np.asarray(geo.roll_angle_start_active, dtype=float)
+    tip = np.asarray(geo.roll_angle_tip, dtype=float)
+    a_lo, a_hi = _pair_bounds("amount", bounds.get("amount", DEFAULT_RELIEF_AMOUNT_BOUNDS), 2)
+    span = tip - sap
+    default_start = np.stack([sap + margin * span, tip - margin * span], axis=1)
+    s_lo, s_hi = _pair_bounds("start_roll_angle", bounds.get("start_roll_angle", default_start), 2)
+    for j in range(2):
+        if not (np.isfinite(a_lo[j]) and np.isfinite(a_hi[j])) or not 0.0 <= a_lo[j] < a_hi[j]:
+            raise ValueError(
+                f"bounds['amount'] of gear {j + 1} = ({a_lo[j]:g}, {a_hi[j]:g}) m is invalid; "
+                "valid: 0 <= lower < upper, finite"
+            )
+        if not (np.isfinite(s_lo[j]) and np.isfinite(s_hi[j])) or not s_lo[j] < s_hi[j]:
+            raise ValueError(
+                f"bounds['start_roll_angle'] of gear {j + 1} = ({s_lo[j]:g}, {s_hi[j]:g}) rad is "
+                "invalid; valid: finite lower < upper"
+            )
+        if s_lo[j] < sap[j] or s_hi[j] >= tip[j]:
+            raise ValueError(
+                f"bounds['start_roll_angle'] of gear {j + 1} = ({math.degrees(s_lo[j]):.4g}, "
+                f"{math.degrees(s_hi[j]):.4g}) deg is outside the path of contact of gear {j + 1}; "
+                f"valid range: [{math.degrees(sap[j]):.4g}, {math.degrees(tip[j]):.4g}) deg"
+            )
+    return (a_lo, a_hi), (s_lo, s_hi)
+
+
+def optimise_tip_relief(
+    pair: GearPair,
+    lubricant,
+    surfaces,
+    op: OperatingPoint,
+    *,
+    speeds_rpm=None,
+    fidelity: Fidelity | None = None,
+    bounds: dict | None = None,
+    shape: str | None = None,
+    steps: int = 40,
+    learning_rate: float = 0.1,
+    optimiser: optax.GradientTransformation | None = None,
+    both_gears: bool = True,
+    gtol: float = 1e-2,
+) -> OptimisationResult:
+    """Tip relief (amount, start roll angle) maximising the mean efficiency over a speed range.
+
+    Args:
+        pair, lubricant, surfaces, op: the design and operating point (as for ``simulate``); the
+            pair's tip relief is the start (clipped into the bounds; with ``both_gears`` the mean of
+            the two gears' values).
+        speeds_rpm: gear 1 speeds, rpm [N], over which the efficiency is averaged (default op's).
+        fidelity: Fidelity (default ``Fidelity.fast()``). One compile per distinct fidelity and shape.
+        bounds: {"amount": (lo, hi) m, "start_roll_angle": (lo, hi) rad}, each optionally per gear;
+            defaults in ``tip_relief_bounds``.
+        shape: relief shape "linear" or "parabolic" (static), "both" (optimise each, return the
+            better), or None (the pair's own).
+        steps, learning_rate, optimiser, gtol: see ``optimise`` (learning rate in box widths per step).
+        both_gears: the same relief on both gears (2 parameters) or one per gear (4 parameters).
+
+    Returns:
+        OptimisationResult: ``pair`` is the optimum GearPair; ``amount`` (m) and ``start_roll_angle``
+        (rad) per gear; objective = mean efficiency; parameter names ``tip_relief_amount`` and
+        ``tip_relief_start_roll_angle`` (suffixed _1/_2 per gear).
+    """
+    fidelity = _common_checks(op, fidelity)
+    if not isinstance(pair, GearPair):
+        raise ValueError(f"pair must be a jaxgear.GearPair; got {type(pair).__name__}")
+    _check_steps(steps)
+    if shape == "both":
+        results = [
+            optimise_tip_relief(
+                pair,
+                lubricant,
+                surfaces,
+                op,
+                speeds_rpm=speeds_rpm,
+                fidelity=fidelity,
+                bounds=bounds,
+                shape=s,
+                steps=steps,
+                learning_rate=learning_rate,
+                optimiser=optimiser,
+                both_gears=both_gears,
+                gtol=gtol,
+            )
+            for s in RELIEF_SHAPES
+        ]
+        return max(results, key=lambda r: r.objective)
+    if shape is not None:
+        check_choice("shape", shape, (*RELIEF_SHAPES, "both"))
+        tr = pair.tip_relief
+        pair = eqx.tree_at(
+            lambda p: p.tip_relief,
+            pair,
+            TipRelief(amount=tr.amount, start_roll_angle=tr.start_roll_angle, shape=shape),
+        )
+    speeds = _speeds(speeds_rpm, op)
+    (a_lo, a_hi), (s_lo, s_hi) = tip_relief_bounds(pair, bounds)
+    amount0 = np.asarray(pair.tip_relief.amount, dtype=float)
+    start0 = np.asarray(pair.tip_relief.start_roll_angle, dtype=float)
+    if both_gears:
+        lower = [max(a_lo), max(s_lo)]
+        upper = [min(a_hi), min(s_hi)]
+        if not (lower[0] < upper[0] and lower[1] < upper[1]):
+            raise ValueError(
+                "bounds of the two gears do not overlap; use both_gears=False for per-gear relief"
+            )
+        x0 = [amount0.mean(), start0.mean()]
+        names = ("tip_relief_amount", "tip_relief_start_roll_angle")
+    else:
+        lower = [*a_lo, *s_lo]
+        upper = [*a_hi, *s_hi]
+        x0 = [*amount0, *start0]
+        names = tuple(
+            f"{base}_{j}"
+            for base in ("tip_relief_amount", "tip_relief_start_roll_angle")
+            for j in (1, 2)
+        )
+    objective = TipReliefObjective(pair, lubricant, surfaces, op, speeds, fidelity, both_gears)
+    result = optimise(
+        objective,
+        x0,
+        (lower, upper),
+        steps=steps,
+        learning_rate=learning_rate,
+        optimiser=optimiser,
+        gtol=gtol,
+        names=names,
+    )
+    best_pair = with_tip_relief(pair, jnp.asarray(result.x), both_gears)
+    return dataclasses.replace(result, pair=best_pair, surfaces=surfaces, op=op, fidelity=fidelity)
+
+
+def _scalar_bounds(name, bounds, unit):
+    try:
+        lo, hi = (float(b) for b in bounds)
+    except (TypeError, ValueError):
+        raise ValueError(f"bounds of {name} = {bounds!r} must be (lower, upper) {unit}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi)) or not 0.0 < lo < hi:
+        raise ValueError(
+            f"bounds of {name} = ({lo:g}, {hi:g}) {unit} are invalid; valid: 0 < lower < upper, finite"
+        )
+    return lo, hi
+
+
+def optimise_torque(
+    pair: GearPair,
+    lubricant,
+    surfaces,
+    op: OperatingPoint,
+    *,
+    bounds: tuple[float, float] | None = None,
+    speeds_rpm=None,
+    fidelity: Fidelity | None = None,
+    steps: int = 40,
+    learning_rate: float = 0.1,
+    optimiser: optax.GradientTransformation | None = None,
+    gtol: float = 1e-2,
+) -> OptimisationResult:
+    """Gear 1 torque (N m) maximising the mean efficiency over ``speeds_rpm`` within ``bounds``.
+
+    The efficiency Ψ = 1 − Φ̄/(T1 ω1) is a ratio, so its best torque is where the loss grows most
+    slowly relative to the transmitted power: with load-dependent friction and relief that is a real
+    trade, though often at a bound. Default bounds: (0.5, 2) × op.torque. Starts at op.torque.
+    Returns an OptimisationResult whose ``op`` carries the optimum torque (name "torque").
+    """
+    fidelity = _common_checks(op, fidelity)
+    _check_steps(steps)
+    t0 = float(op.torque)
+    lo, hi = _scalar_bounds("torque", bounds if bounds is not None else (0.5 * t0, 2 * t0), "N m")
+    objective = TorqueObjective(pair, lubricant, surfaces, op, _speeds(speeds_rpm, op), fidelity)
+    result = optimise(
+        objective,
+        [t0],
+        ([lo], [hi]),
+        steps=steps,
+        learning_rate=learning_rate,
+        optimiser=optimiser,
+        gtol=gtol,
+        names=("torque",),
+    )
+    best_op = OperatingPoint(
+        torque=float(result.x[0]), speed_rpm=op.speed_rpm, inlet_temperature=op.inlet_temperature
+    )
+    return dataclasses.replace(result, pair=pair, surfaces=surfaces, op=best_op, fidelity=fidelity)
+
+
+def optimise_roughness_scale(
+    pair: GearPair,
+    lubricant,
+    surfaces,
+    op: OperatingPoint,
+    *,
+    bounds: tuple[float, float] = DEFAULT_ROUGHNESS_BOUNDS,
+    speeds_rpm=None,
+    fidelity: Fidelity | None = None,
+    steps: int = 40,
+    learning_rate: float = 0.1,
+    optimiser: optax.GradientTransformation | None = None,
+    gtol: float = 1e-2,
+) -> OptimisationResult:
+    """Roughness scale (S_j = scale · z_j, dimensionless) maximising the mean efficiency.
+
+    ``gradient_start`` of the result is the efficiency gain per unit roughness scale at the surfaces'
+    own scale (clipped into the bounds), the figure a designer weighs against the cost of finishing.
+    Default bounds (0.1, 3). Returns an OptimisationResult whose ``surfaces`` carries the optimum scale
+    (name "roughness_scale").
+    """
+    fidelity = _common_checks(op, fidelity)
+    _check_steps(steps)
+    lo, hi = _scalar_bounds("roughness_scale", bounds, "")
+    objective = RoughnessScaleObjective(
+        pair, lubricant, surfaces, op, _speeds(speeds_rpm, op), fidelity
+    )
+    result = optimise(
+        objective,
+        [float(surfaces.scale)],
+        ([lo], [hi]),
+        steps=steps,
+        learning_rate=learning_rate,
+        optimiser=optimiser,
+        gtol=gtol,
+        names=("roughness_scale",),
+    )
+    best = eqx.tree_at(lambda s: s.scale, surfaces, jnp.asarray(result.x[0]))
+    return dataclasses.replace(result, pair=pair, surfaces=best, op=op, fidelity=fidelity)
+
+
+__all__ = [
+    "OptimisationResult",
+    "STATUS_NAMES",
+    "TipReliefObjective",
+    "default_optimiser",
+    "optimise",
+    "optimise_roughness_scale",
+    "optimise_tip_relief",
+    "optimise_torque",
+    "tip_relief_bounds",
+    "value_and_gradient",
+    "with_tip_relief",
+]

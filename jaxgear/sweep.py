@@ -1,0 +1,249 @@
+"""Sweeps of the tribo-dynamic model over speeds (and any other traced input).
+
+``mode="parallel"`` vmaps independent points (chunked, sharded over devices, checkpointed);
+``mode="continuation"`` marches through the points in order with ``lax.scan``, starting each point from
+its neighbour's converged state (the dynamic orbit and the mesh interface), as the paper's stepwise
+speed increase does: near jump regions of the dynamics it follows one branch and can show hysteresis.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .fidelity import Fidelity
+from .operating import OperatingPoint
+from .sweep_engine import STATUS_NAMES as POINT_STATUS_NAMES
+from .sweep_engine import run_continuation, run_points
+from .tribodynamics import STATUS_NAMES, simulate_with_state
+
+#: Inputs a sweep may vary, besides the speed.
+SWEEPABLE = ("speed_rpm", "torque", "inlet_temperature", "roughness_scale", "tip_relief_amount")
+
+_SCALARS = (
+    "power_loss",
+    "power_loss_sliding",
+    "power_loss_rolling",
+    "efficiency",
+    "dte_rms",
+    "fixed_point_residual",
+)
+
+
+class SweepResult(eqx.Module):
+    """Results of a sweep: one row per point.
+
+    Attributes:
+        inputs: dict of the varied inputs (SI; speed in rpm) [N].
+        power_loss, power_loss_sliding, power_loss_rolling (W), efficiency, dte_rms (m),
+        fixed_point_residual: [N] (NaN where a point failed).
+        power_loss_position: Φ(t_i) per point, W [N, M].
+        status: per point, the simulation status (0 ok; see ``tribodynamics.STATUS_NAMES``), or 5 where
+            the point's chunk raised or its outputs were not finite.
+        converged: status == 0.
+        messages: errors of failed chunks.
+    """
+
+    inputs: dict
+    power_loss: np.ndarray
+    power_loss_sliding: np.ndarray
+    power_loss_rolling: np.ndarray
+    efficiency: np.ndarray
+    dte_rms: np.ndarray
+    fixed_point_residual: np.ndarray
+    power_loss_position: np.ndarray
+    status: np.ndarray
+    messages: tuple[str, ...] = eqx.field(static=True, default=())
+
+    @property
+    def converged(self) -> np.ndarray:
+        return np.asarray(self.status) == 0
+
+    def status_names(self) -> list[str]:
+        names = {**STATUS_NAMES, 5: "failed (chunk raised or non-finite)"}
+        return [names.get(int(s), str(int(s))) for s in np.asarray(self.status)]
+
+    def to_csv(self, path: str | Path) -> Path:
+        """One row per point; SI except speed (rpm), efficiency (%), DTE (µm), temperature (°C)."""
+        path = Path(path)
+        cols = {}
+        for k, v in self.inputs.items():
+            if k == "inlet_temperature":
+                cols["inlet_temperature_C"] = np.asarray(v) - 273.15
+            elif k == "tip_relief_amount":
+                cols["tip_relief_um"] = np.asarray(v) * 1e6
+            else:
+                cols[k] = np.asarray(v)
+        cols.update(
+            power_loss_W=self.power_loss,
+            power_loss_sliding_W=self.power_loss_sliding,
+            power_loss_rolling_W=self.power_loss_rolling,
+            efficiency_percent=100.0 * np.asarray(self.efficiency),
+            dte_rms_um=1e6 * np.asarray(self.dte_rms),
+            fixed_point_residual=self.fixed_point_residual,
+            status=self.status,
+        )
+        names = list(cols)
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow([*names, "status_name"])
+            for i, label in enumerate(self.status_names()):
+                w.writerow([f"{np.asarray(cols[n])[i]:.10g}" for n in names] + [label])
+        return path
+
+
+def _apply(pair, surfaces, op, point):
+    """The point's pair, surfaces and operating point with the varied inputs substituted."""
+    op = OperatingPoint(
+        torque=point.get("torque", op.torque),
+        speed_rpm=point.get("speed_rpm", op.speed_rpm),
+        inlet_temperature=point.get("inlet_temperature", op.inlet_temperature),
+    )
+    if "roughness_scale" in point:
+        surfaces = eqx.tree_at(lambda s: s.scale, surfaces, jnp.asarray(point["roughness_scale"]))
+    if "tip_relief_amount" in point:
+        amount = jnp.stack([point["tip_relief_amount"], point["tip_relief_amount"]])
+        pair = eqx.tree_at(lambda p: p.tip_relief.amount, pair, amount)
+    return pair, surfaces, op
+
+
+def _outputs(result):
+    out = {k: getattr(result, k) for k in _SCALARS}
+    out["power_loss_position"] = result.power_loss_position
+    out["sim_status"] = result.status
+    out["converged"] = result.converged
+    return out
+
+
+def sweep(
+    pair,
+    lubricant,
+    surfaces,
+    op: OperatingPoint,
+    *,
+    speeds_rpm=None,
+    fidelity: Fidelity | None = None,
+    mode: str = "parallel",
+    chunk_size: int | None = None,
+    checkpoint_dir: str | Path | None = None,
+    progress: bool = False,
+    devices=None,
+    **vary,
+) -> SweepResult:
+    """Simulate many points that differ in speed (rpm) and/or other traced inputs.
+
+    Args:
+        pair, lubricant, surfaces, op: the base point (as for ``simulate``).
+        speeds_rpm: gear 1 speeds, rpm [N] (or a scalar).
+        fidelity: Fidelity (default ``Fidelity.fast()``).
+        mode: "parallel" (vmap, chunked, sharded over ``devices``) or "continuation" (``lax.scan`` in
+            the given order, each point warm-started from the previous one).
+        chunk_size: points per chunk (default all); finished chunks go to ``checkpoint_dir`` if given,
+            and a rerun with the same inputs resumes from them.
+        progress: progress bar on stderr.
+        devices: devices to shard parallel chunks over (default all local devices).
+        **vary: other inputs per point, from ``SWEEPABLE``: torque (N m), inlet_temperature (K),
+            roughness_scale, tip_relief_amount (m, both gears); arrays of length N or scalars.
+
+    Returns:
+        SweepResult with per-point status; every good point is kept when others fail.
+    """
+    fidelity = Fidelity.fast() if fidelity is None else fidelity
+    if mode not in ("parallel", "continuation"):
+        raise ValueError(f"mode = {mode!r} is not valid; valid choices: 'parallel', 'continuation'")
+    unknown = set(vary) - set(SWEEPABLE)
+    if unknown:
+        raise ValueError(
+            f"cannot sweep {sorted(unknown)}; sweepable inputs: {', '.join(SWEEPABLE)}"
+        )
+    if speeds_rpm is not None:
+        vary = {"speed_rpm": speeds_rpm, **vary}  # speed first: the CSV's leading column
+    if not vary:
+        raise ValueError("nothing to sweep: give speeds_rpm or another input from SWEEPABLE")
+    n = max(np.size(v) for v in vary.values())
+    inputs = {}
+    for k, v in vary.items():
+        arr = np.asarray(v, dtype=float).reshape(-1)
+        if arr.size == 1:
+            arr = np.full(n, arr[0])
+        if arr.size != n:
+            raise ValueError(f"{k} has {arr.size} points; expected 1 or {n}")
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"{k} contains non-finite values; valid range: finite numbers")
+        inputs[k] = arr
+    _validate_points(pair, surfaces, op, inputs)
+
+    def point_fn(point):
+        p, s, o = _apply(pair, surfaces, op, point)
+        return _outputs(simulate_with_state(p, lubricant, s, o, fidelity)[0])
+
+    if mode == "parallel":
+        raw = run_points(
+            point_fn,
+            inputs,
+            chunk_size=chunk_size,
+            checkpoint_dir=checkpoint_dir,
+            progress=progress,
+            devices=devices,
+            label="sweep",
+        )
+    else:
+        first = jax.tree_util.tree_map(lambda x: jnp.asarray(x[0]), inputs)
+        p0, s0, o0 = _apply(pair, surfaces, op, first)
+        _, warm0 = eqx.filter_jit(simulate_with_state)(p0, lubricant, s0, o0, fidelity)
+
+        def step(warm, point):
+            p, s, o = _apply(pair, surfaces, op, point)
+            result, new_warm = simulate_with_state(p, lubricant, s, o, fidelity, warm)
+            # A failed point must not poison the rest of the march: keep the last good state.
+            good = result.converged
+            carry = jax.tree_util.tree_map(lambda a, b: jnp.where(good, a, b), new_warm, warm)
+            return carry, _outputs(result)
+
+        raw = run_continuation(
+            step,
+            warm0,
+            inputs,
+            chunk_size=chunk_size,
+            checkpoint_dir=checkpoint_dir,
+            progress=progress,
+            label="continuation",
+        )
+    out = raw.outputs
+    status = np.where(raw.status >= 2, 5, np.asarray(out["sim_status"])).astype(np.int32)
+    return SweepResult(
+        inputs=inputs,
+        power_loss=np.asarray(out["power_loss"]),
+        power_loss_sliding=np.asarray(out["power_loss_sliding"]),
+        power_loss_rolling=np.asarray(out["power_loss_rolling"]),
+        efficiency=np.asarray(out["efficiency"]),
+        dte_rms=np.asarray(out["dte_rms"]),
+        fixed_point_residual=np.asarray(out["fixed_point_residual"]),
+        power_loss_position=np.asarray(out["power_loss_position"]),
+        status=status,
+        messages=raw.messages,
+    )
+
+
+def _validate_points(pair, surfaces, op, inputs):
+    """Every point must be a valid operating point: check them all before any work starts."""
+    from ._validation import check_non_negative, check_positive, check_range
+
+    if "speed_rpm" in inputs:
+        check_positive("speeds_rpm", inputs["speed_rpm"], "rpm")
+    if "torque" in inputs:
+        check_positive("torque", inputs["torque"], "N m")
+    if "inlet_temperature" in inputs:
+        check_range("inlet_temperature", inputs["inlet_temperature"], 200.0, 600.0, unit="K")
+    if "roughness_scale" in inputs:
+        check_non_negative("roughness_scale", inputs["roughness_scale"])
+    if "tip_relief_amount" in inputs:
+        check_non_negative("tip_relief_amount", inputs["tip_relief_amount"], "m")
+
+
+__all__ = ["SWEEPABLE", "SweepResult", "sweep", "POINT_STATUS_NAMES"]

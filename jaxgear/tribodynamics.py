@@ -1,0 +1,467 @@
+"""The thermal tribo-dynamic model: gear dynamics and the lubricated contacts solved together.
+
+REFERENCE §1 (paper): the dynamics, given the mesh interface tables (EHL damping cm and friction forces
+F1, F2 per position and tooth pair), give the dynamic tooth forces W_T and surface velocities uj; the
+contacts, given W_T and uj, give new tables; the two are iterated to a fixed point. jaxgear solves the
+fixed point with optimistix (damped fixed-point iteration) and differentiates the converged solution
+implicitly (``optx.ImplicitAdjoint`` with a matrix-free GMRES solve of (I − ∂T/∂x)), so gradients never
+pass through the iterations. The dynamic periodic orbit is carried in the fixed-point state, so each
+iteration's shooting starts from the previous orbit.
+
+The quasi-static variant (``Fidelity(dynamics="quasi_static")``) uses W_T = W_sT and the kinematic surface
+velocities and needs no iteration.
+"""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import lineax as lx
+import optimistix as optx
+from jaxtyping import Array, Bool, Float, Int
+
+from ._validation import check_non_negative, is_concrete
+from .anderson import Anderson
+from .dynamics.model import DynamicsOptions, MeshInterface
+from .dynamics.response import dte_harmonic_amplitudes, dynamic_response
+from .fidelity import Fidelity
+from .gear.geometry import gear_geometry
+from .gear.mesh import MeshCycle, mesh_cycle
+from .gear.pair import GearPair
+from .lubrication.friction_models import XuFriction
+from .material import reduced_modulus
+from .operating import OperatingPoint
+from .power_loss import cycle_mean, efficiency, total_per_position
+
+# Status codes of a simulation (0 is success; the first failure found, in this order, is reported).
+STATUS_OK = 0
+STATUS_FIXED_POINT = 1  # tribo-dynamic fixed point did not reach its tolerance
+STATUS_DYNAMICS = 2  # periodic orbit not converged or unstable
+STATUS_CONTACT = 3  # a contact solve did not converge
+STATUS_NON_FINITE = 4
+STATUS_NAMES = {
+    STATUS_OK: "ok",
+    STATUS_FIXED_POINT: "tribo-dynamic fixed point not converged",
+    STATUS_DYNAMICS: "dynamic periodic orbit not converged or unstable",
+    STATUS_CONTACT: "contact solver not converged",
+    STATUS_NON_FINITE: "non-finite result",
+}
+
+# The friction force of the formula rungs changes sign with the sliding velocity through a smooth
+# sign over a slide-to-roll ratio of SIGN_SLIDE_TO_ROLL: real EHL traction grows linearly with slip up
+# to ~1-2 % SRR before it saturates, and a discontinuous sign makes the tribo-dynamic fixed point
+# chatter between neighbouring states (vibration moves the sign change from one position to the next).
+SIGN_SLIDE_TO_ROLL = 0.02
+
+
+class ContactForces(eqx.Module):
+    """What the contacts of one mesh cycle give back, per [position, pair] (SI).
+
+    Attributes:
+        friction_sliding: Fs, N (sign along u2 − u1, paper Eq. 15).
+        friction_rolling: Fr, N (paper Eq. 15).
+        damping: cm, N s/m (paper Eq. 13).
+        power_sliding: sliding part of Φn, W.
+        power_rolling: rolling part of Φn, W.
+        friction_coefficient: (Fs² + Fr²)^½ / W_T where loaded (informative), dimensionless.
+        converged: every contact solve converged.
+    """
+
+    friction_sliding: Float[Array, "M 2"]
+    friction_rolling: Float[Array, "M 2"]
+    damping: Float[Array, "M 2"]
+    power_sliding: Float[Array, "M 2"]
+    power_rolling: Float[Array, "M 2"]
+    friction_coefficient: Float[Array, "M 2"]
+    converged: Bool[Array, ""]
+
+
+def _smooth_sign(x, width):
+    return x / jnp.sqrt(x * x + width * width)
+
+
+def _safe_sqrt(x):
+    ok = x > 0
+    return jnp.where(ok, jnp.sqrt(jnp.where(ok, x, 1.0)), 0.0)
+
+
+def formula_contact_forces(
+    pair: GearPair,
+    lubricant,
+    surfaces,
+    mesh: MeshCycle,
+    fidelity: Fidelity,
+    load,
+    u1,
+    u2,
+    inlet_temperature,
+) -> ContactForces:
+    """Constant-μ and regression-formula rungs: Fs = μ W_T sgn(u2 − u1), no rolling loss, no damping.
+
+    The regression rung uses Xu, Kahraman, Anderson & Maddock (2007) (REFERENCE §9) at the dynamic
+    Hertz pressure, slide-to-roll ratio and entraining velocity of each contact, the inlet viscosity
+    and the composite roughness. These rungs model the sliding loss only: rolling (Poiseuille) loss and
+    EHL damping come from the EHL rungs.
+    """
+    width = pair.face_width
+    loaded = load > 0
+    w = jnp.where(loaded, load, 0.0) / width
+    e_red = reduced_modulus(*pair.materials)
+    radius = mesh.reduced_radius
+    us = u1 - u2
+    if fidelity.friction == "constant":
+        mu = jnp.full_like(load, fidelity.constant_mu)
+    else:
+        ph = _safe_sqrt(w * e_red / (2.0 * jnp.pi * radius))
+        ph_safe = jnp.where(loaded, jnp.maximum(ph, 1e6), 1e9)
+        ve = jnp.maximum(u1 + u2, 1e-6)
+        eta0 = lubricant.viscosity(jnp.zeros(()), inlet_temperature)
+        mu = XuFriction().coefficient(
+            ph_safe, 2.0 * us / ve, ve, eta0, radius, surfaces.composite_rq
+        )
+        mu = jnp.where(loaded, mu, 0.0)
+    force = mu * jnp.where(loaded, load, 0.0)
+    sign = _smooth_sign(u2 - u1, SIGN_SLIDE_TO_ROLL * 0.5 * jnp.abs(u1 + u2) + 1e-9)
+    zeros = jnp.zeros_like(force)
+    return ContactForces(
+        friction_sliding=force * sign,
+        friction_rolling=zeros,
+        damping=zeros,
+        power_sliding=force * sign * (u2 - u1),
+        power_rolling=zeros,
+        friction_coefficient=mu,
+        converged=jnp.asarray(True),
+    )
+
+
+def contact_forces(
+    pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature, initial=None
+):
+    """Dispatch on ``fidelity.friction`` (a static choice: unused rungs are never traced).
+
+    Returns (ContactForces, contact state): the contact state is the batch of EHL solutions on the EHL
+    rungs (a warm start for the next evaluation, and the fields), None on the formula rungs.
+    """
+    if fidelity.friction in ("constant", "regression"):
+        forces = formula_contact_forces(
+            pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature
+        )
+        return forces, None
+    from .lubrication.contacts import ehl_contact_forces
+
+    return ehl_contact_forces(
+        pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature, initial
+    )
+
+
+def interface_from_forces(forces: ContactForces) -> MeshInterface:
+    """Paper Eq. 14-15 without the cm term (the dynamics adds cm times the vibratory sliding speed):
+    F1 = Fs − Fr, F2 = Fs + Fr."""
+    return MeshInterface(
+        damping=forces.damping,
+        friction_1=forces.friction_sliding - forces.friction_rolling,
+        friction_2=forces.friction_sliding + forces.friction_rolling,
+    )
+
+
+class SimulationResult(eqx.Module):
+    """The tribo-dynamic (or quasi-static) solution over one mesh cycle (SI; M positions, 2 pair slots).
+
+    Attributes:
+        power_loss: Φ̄, cycle-mean mesh power loss, W (paper Eq. 17).
+        power_loss_sliding, power_loss_rolling: its sliding and rolling parts, W.
+        efficiency: Ψ = 1 − Φ̄/(T1 ω1).
+        dte_rms: RMS dynamic transmission error over the first 10 mesh harmonics, m (REFERENCE §7 R1);
+            quasi-static: of the static TE.
+        power_loss_position: Φ(t_i), W [M]; power_loss_pair: Φn(t_i), W [M, 2] (and its sliding and
+            rolling parts power_sliding_pair, power_rolling_pair).
+        tooth_force: W_T per pair, N [M, 2]; surface_velocity: uj per [position, pair, gear], m/s.
+        hertz_pressure: Hertz pressure of W_T per pair, Pa [M, 2].
+        friction_coefficient: per pair [M, 2]; damping: cm per pair, N s/m [M, 2].
+        dynamic_te: εd(t_i), m [M]; roll_angle: gear 1 roll angle of slot 0, rad [M].
+        converged: everything converged; status: 0 ok, else the first failure (see STATUS_NAMES);
+        fixed_point_residual: max relative change of the interface tables in the last iteration;
+        fixed_point_iterations: iterations used (0 for quasi-static).
+    """
+
+    power_loss: Float[Array, ""]
+    power_loss_sliding: Float[Array, ""]
+    power_loss_rolling: Float[Array, ""]
+    efficiency: Float[Array, ""]
+    dte_rms: Float[Array, ""]
+    power_loss_position: Float[Array, " M"]
+    power_loss_pair: Float[Array, "M 2"]
+    power_sliding_pair: Float[Array, "M 2"]
+    power_rolling_pair: Float[Array, "M 2"]
+    tooth_force: Float[Array, "M 2"]
+    surface_velocity: Float[Array, "M 2 2"]
+    hertz_pressure: Float[Array, "M 2"]
+    friction_coefficient: Float[Array, "M 2"]
+    damping: Float[Array, "M 2"]
+    dynamic_te: Float[Array, " M"]
+    roll_angle: Float[Array, " M"]
+    converged: Bool[Array, ""]
+    status: Int[Array, ""]
+    fixed_point_residual: Float[Array, ""]
+    fixed_point_iterations: Int[Array, ""]
+
+
+def kinematic_velocities(pair: GearPair, mesh: MeshCycle, omega1):
+    """Kinematic surface velocities uj = ρj ωj per [position, pair, gear], m/s."""
+    omega = jnp.stack([omega1, omega1 * pair.teeth[0] / pair.teeth[1]])
+    return mesh.radius_of_curvature * omega
+
+
+def _hertz(pair, mesh, load):
+    w = jnp.maximum(load, 0.0) / pair.face_width
+    return _safe_sqrt(w * reduced_modulus(*pair.materials) / (2.0 * jnp.pi * mesh.reduced_radius))
+
+
+def _dynamics_options(fidelity: Fidelity) -> DynamicsOptions:
+    return DynamicsOptions(
+        steps_per_period=fidelity.steps_per_period,
+        n_positions=fidelity.n_positions,
+        backlash=fidelity.backlash,
+    )
+
+
+def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, iterations):
+    power_pair = forces.power_sliding + forces.power_rolling
+    sliding = cycle_mean(total_per_position(forces.power_sliding))
+    rolling = cycle_mean(total_per_position(forces.power_rolling))
+    loss = sliding + rolling
+    dte_rms = jnp.sqrt(jnp.sum(dte_harmonic_amplitudes(dte) ** 2))
+    values = jnp.stack([loss, dte_rms, jnp.sum(power_pair)])
+    status = jnp.where(jnp.all(jnp.isfinite(values)), status, STATUS_NON_FINITE)
+    return SimulationResult(
+        power_loss=loss,
+        power_loss_sliding=sliding,
+        power_loss_rolling=rolling,
+        efficiency=efficiency(loss, op.torque, op.omega1),
+        dte_rms=dte_rms,
+        power_loss_position=total_per_position(power_pair),
+        power_loss_pair=power_pair,
+        power_sliding_pair=forces.power_sliding,
+        power_rolling_pair=forces.power_rolling,
+        tooth_force=load,
+        surface_velocity=velocity,
+        hertz_pressure=_hertz(pair, mesh, load),
+        friction_coefficient=forces.friction_coefficient,
+        damping=forces.damping,
+        dynamic_te=dte,
+        roll_angle=mesh.roll_angle,
+        converged=status == STATUS_OK,
+        status=jnp.asarray(status, dtype=jnp.int32),
+        fixed_point_residual=jnp.asarray(residual, dtype=loss.dtype),
+        fixed_point_iterations=jnp.asarray(iterations, dtype=jnp.int32),
+    )
+
+
+def _quasi_static(pair, lubricant, surfaces, op, fidelity, mesh):
+    velocity = kinematic_velocities(pair, mesh, op.omega1)
+    load = mesh.normal_load
+    forces, _ = contact_forces(
+        pair,
+        lubricant,
+        surfaces,
+        mesh,
+        fidelity,
+        load,
+        velocity[..., 0],
+        velocity[..., 1],
+        op.inlet_temperature,
+    )
+    status = jnp.where(forces.converged, STATUS_OK, STATUS_CONTACT)
+    return _assemble(pair, op, mesh, forces, load, velocity, mesh.static_te, status, 0.0, 0)
+
+
+def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
+    options = _dynamics_options(fidelity)
+    m = mesh.n_positions
+
+    def respond(interface, guess):
+        return dynamic_response(
+            pair, op, mesh=mesh, interface=interface, options=options, initial_state=guess
+        )
+
+    # Plain iteration damps inside the map; Anderson damps in its mixing (same fixed point).
+    beta = fidelity.relaxation if fidelity.anderson_memory == 0 else 1.0
+
+    # The fixed-point state carries, beside the interface tables, the orbit (a warm start for the next
+    # shooting) and what the result needs (tooth forces, velocities, DTE, contact forces), so the
+    # dynamics and the contacts are traced once, inside the iteration.
+    def step(state, _):
+        interface = state["interface"]
+        # Before the first orbit exists, shoot from the static equilibrium (NaN guess).
+        guess = jnp.where(state["started"] > 0.5, state["guess"], jnp.nan)
+        resp = respond(interface, guess)
+        u = resp.surface_velocity
+        forces, contacts = contact_forces(
+            pair,
+            lubricant,
+            surfaces,
+            mesh,
+            fidelity,
+            resp.tooth_force,
+            u[..., 0],
+            u[..., 1],
+            op.inlet_temperature,
+            state["contacts"],
+        )
+        new = interface_from_forces(forces)
+        relaxed = jax.tree_util.tree_map(lambda a, b: (1.0 - beta) * a + beta * b, interface, new)
+        return {
+            "interface": relaxed,
+            "guess": resp.initial_state,
+            "load": resp.tooth_force,
+            "velocity": u,
+            "dte": resp.dynamic_te,
+            "forces": forces,
+            "dynamics_ok": jnp.where(resp.status == 0, 1.0, 0.0),
+            "started": jnp.ones_like(state["started"]),
+            "previous": interface.friction_1,
+            "contacts": contacts,
+        }
+
+    zeros = jnp.zeros((m, 2), dtype=op.torque.dtype)
+    if warm is None:
+        interface0 = MeshInterface(damping=zeros, friction_1=zeros, friction_2=zeros)
+        guess0, started0 = jnp.zeros(13, dtype=zeros.dtype), 0.0
+    else:  # continuation: the neighbouring point's converged interface and orbit
+        interface0, guess0, started0 = warm.interface, warm.orbit, 1.0
+    velocity0 = kinematic_velocities(pair, mesh, op.omega1)
+    # EHL rungs: cold solves at the quasi-static state, then every iteration warm-starts from the last
+    # (one cold and one warm trace of the solver); formula rungs carry no contact state.
+    forces0, contacts0 = contact_forces(
+        pair,
+        lubricant,
+        surfaces,
+        mesh,
+        fidelity,
+        mesh.normal_load,
+        velocity0[..., 0],
+        velocity0[..., 1],
+        op.inlet_temperature,
+    )
+    state0 = {
+        "interface": interface0,
+        "guess": guess0,
+        "load": mesh.normal_load,
+        "velocity": velocity0,
+        "dte": mesh.static_te,
+        "forces": forces0,
+        "contacts": contacts0,
+        "dynamics_ok": jnp.asarray(1.0, dtype=zeros.dtype),
+        "started": jnp.asarray(started0, dtype=zeros.dtype),
+        "previous": zeros,
+    }
+    if fidelity.anderson_memory > 0:
+        # Anderson mixing of the interface tables and the orbit; the carried outputs follow T.
+        solver = Anderson(
+            rtol=fidelity.fixed_point_tolerance,
+            atol=fidelity.fixed_point_tolerance * 1e-3,
+            memory=fidelity.anderson_memory,
+            beta=fidelity.relaxation,
+            core=lambda st: (st["interface"], st["guess"]),
+            replace_core=lambda st, c: {**st, "interface": c[0], "guess": c[1]},
+        )
+    else:
+        solver = optx.FixedPointIteration(
+            rtol=fidelity.fixed_point_tolerance,
+            atol=fidelity.fixed_point_tolerance * 1e-3,
+            norm=optx.max_norm,
+        )
+    adjoint = optx.ImplicitAdjoint(linear_solver=lx.GMRES(rtol=1e-10, atol=1e-10, restart=20))
+    sol = optx.fixed_point(
+        step,
+        solver,
+        state0,
+        max_steps=fidelity.max_fixed_point_iterations,
+        adjoint=adjoint,
+        throw=False,
+    )
+    state = sol.value
+    forces = state["forces"]
+    new = state["interface"].friction_1
+    scale = jnp.maximum(jnp.max(jnp.abs(new)), 1e-12)
+    residual = jax.lax.stop_gradient(jnp.max(jnp.abs(new - state["previous"])) / scale)
+    fp_ok = sol.result == optx.RESULTS.successful
+    status = jnp.where(
+        ~fp_ok,
+        STATUS_FIXED_POINT,
+        jnp.where(
+            state["dynamics_ok"] < 0.5,
+            STATUS_DYNAMICS,
+            jnp.where(forces.converged, STATUS_OK, STATUS_CONTACT),
+        ),
+    )
+    result = _assemble(
+        pair,
+        op,
+        mesh,
+        forces,
+        state["load"],
+        state["velocity"],
+        state["dte"],
+        status,
+        residual,
+        sol.stats["num_steps"],
+    )
+    return result, WarmStart(interface=state["interface"], orbit=state["guess"])
+
+
+class WarmStart(eqx.Module):
+    """A converged tribo-dynamic state to start a neighbouring point from (continuation sweeps)."""
+
+    interface: MeshInterface
+    orbit: Float[Array, " 13"]
+
+
+def simulate_with_state(pair, lubricant, surfaces, op, fidelity, warm: WarmStart | None = None):
+    """``simulate`` that also returns the WarmStart of its converged state (traceable: no checks).
+
+    The quasi-static rung has no state: its WarmStart is zeros, and ``warm`` is ignored.
+    """
+    mesh = mesh_cycle(pair, op.torque, fidelity.n_positions, stiffness=fidelity.stiffness)
+    if fidelity.dynamics == "quasi_static":
+        zeros = jnp.zeros((fidelity.n_positions, 2), dtype=op.torque.dtype)
+        none = WarmStart(MeshInterface(zeros, zeros, zeros), jnp.zeros(13, dtype=zeros.dtype))
+        return _quasi_static(pair, lubricant, surfaces, op, fidelity, mesh), none
+    return _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm)
+
+
+@eqx.filter_jit
+def _simulate(pair, lubricant, surfaces, op, fidelity):
+    return simulate_with_state(pair, lubricant, surfaces, op, fidelity)[0]
+
+
+def simulate(
+    pair: GearPair,
+    lubricant,
+    surfaces,
+    op: OperatingPoint,
+    fidelity: Fidelity | None = None,
+) -> SimulationResult:
+    """Power loss, efficiency and dynamic response of ``pair`` at ``op``.
+
+    Args:
+        pair: GearPair.
+        lubricant: Lubricant (inlet viscosity, rheology).
+        surfaces: Surfaces (roughness; ``jg.presets.smooth()`` for none).
+        op: OperatingPoint (torque N m, speed rpm, inlet temperature K).
+        fidelity: Fidelity (default ``Fidelity.fast()``).
+
+    Returns:
+        SimulationResult; ``converged``/``status`` report failures, never silent NaN. Differentiable in
+        every traced input (forward mode, ``jax.jvp``/``jax.jacfwd``).
+    """
+    fidelity = Fidelity.fast() if fidelity is None else fidelity
+    if not isinstance(fidelity, Fidelity):
+        raise ValueError(f"fidelity must be a jaxgear.Fidelity; got {type(fidelity).__name__}")
+    if not isinstance(op, OperatingPoint):
+        raise ValueError(f"op must be a jaxgear.OperatingPoint; got {type(op).__name__}")
+    if is_concrete(surfaces):
+        check_non_negative("surfaces.composite_rq", surfaces.composite_rq, "m")
+    gear_geometry(pair)  # shapes and geometry checks happen at construction; nothing to redo
+    return _simulate(pair, lubricant, surfaces, op, fidelity)

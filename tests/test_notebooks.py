@@ -1,0 +1,56 @@
+"""The research notebooks run top to bottom on the public API (nbclient, python3 kernel)."""
+
+import os
+from pathlib import Path
+
+import nbformat
+import pytest
+from nbclient import NotebookClient
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = ROOT / "notebooks"
+DEFAULT = ("quickstart.ipynb", "tip_relief_optimisation.ipynb")
+
+
+def _execute(name, monkeypatch, timeout=900):
+    nb = nbformat.read(NOTEBOOKS / name, as_version=4)
+    env_path = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
+    monkeypatch.setenv("PYTHONPATH", env_path)  # the kernel is a subprocess: import this checkout
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    NotebookClient(
+        nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(NOTEBOOKS)}}
+    ).execute()
+    errors = [
+        out
+        for cell in nb.cells
+        if cell.cell_type == "code"
+        for out in cell.get("outputs", [])
+        if out.get("output_type") == "error"
+    ]
+    assert not errors
+    return "".join(
+        out.get("text", "")
+        for cell in nb.cells
+        if cell.cell_type == "code"
+        for out in cell.get("outputs", [])
+    )
+
+
+def test_quickstart_runs(monkeypatch):
+    text = _execute("quickstart.ipynb", monkeypatch)
+    assert "contact ratio 1.7547" in text
+    assert "all converged: True" in text
+    assert "converged True" in text
+
+
+def test_tip_relief_optimisation_notebook(monkeypatch):
+    text = _execute("tip_relief_optimisation.ipynb", monkeypatch)
+    assert "grid best" in text and "optimum:" in text
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name", sorted(p.name for p in NOTEBOOKS.glob("*.ipynb") if p.name not in DEFAULT)
+)
+def test_other_notebooks_run(name, monkeypatch):
+    _execute(name, monkeypatch, timeout=1800)
