@@ -42,6 +42,7 @@ from .._validation import (
     check_range,
     is_concrete,
 )
+from ..gear.geometry import hertz_half_width, hertz_pressure
 from . import deformation as deformation_mod
 from . import rheology
 from .lubricant import Lubricant
@@ -109,12 +110,12 @@ class LineContact(eqx.Module):
     @property
     def hertz_half_width(self):
         """b = √(8 w' R/(π E')), m."""
-        return jnp.sqrt(8.0 * self.load_per_width * self.reduced_radius / (jnp.pi * self.e_reduced))
+        return hertz_half_width(self.load_per_width, self.reduced_radius, self.e_reduced)
 
     @property
     def hertz_pressure(self):
         """ph = √(w' E'/(2π R)), Pa."""
-        return jnp.sqrt(self.load_per_width * self.e_reduced / (2.0 * jnp.pi * self.reduced_radius))
+        return hertz_pressure(self.load_per_width, self.reduced_radius, self.e_reduced)
 
 
 class EHLModel(eqx.Module):
