@@ -76,11 +76,29 @@ def _paper_points(ax, ymax=None):
         ax.axvline(rpm, color="0.7", lw=0.8, ls=":")
 
 
-def plot_dte_rms(speeds_rpm, dte_rms, path, *, label="tribo-dynamic", others=()):
-    """RMS dynamic transmission error (first 10 mesh harmonics) against speed, like the paper's Fig. 3."""
+def _mark_flagged(ax, speeds_rpm, values, ok):
+    """Points whose solution did not converge (e.g. no stable periodic orbit) as red crosses."""
+    if ok is None:
+        return
+    bad = ~np.asarray(ok, dtype=bool)
+    if bad.any():
+        ax.plot(
+            np.asarray(speeds_rpm)[bad],
+            np.asarray(values)[bad],
+            "x",
+            color="C3",
+            ms=5,
+            label="not converged (flagged)",
+        )
+
+
+def plot_dte_rms(speeds_rpm, dte_rms, path, *, label="tribo-dynamic", others=(), ok=None):
+    """RMS dynamic transmission error (first 10 mesh harmonics) against speed, like the paper's Fig. 3.
+    ``ok``: per-speed convergence flags; flagged speeds are marked."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(speeds_rpm, np.asarray(dte_rms) * 1e6, ".-", ms=3, label=label)
+    _mark_flagged(ax, speeds_rpm, np.asarray(dte_rms) * 1e6, ok)
     for other_label, values in others:
         ax.plot(speeds_rpm, np.asarray(values) * 1e6, "--", label=other_label)
     _paper_points(ax)
@@ -93,7 +111,7 @@ def plot_dte_rms(speeds_rpm, dte_rms, path, *, label="tribo-dynamic", others=())
     return Path(path)
 
 
-def plot_power_loss(speeds_rpm, dynamic, quasi_static, path):
+def plot_power_loss(speeds_rpm, dynamic, quasi_static, path, ok=None):
     """Cycle-mean power loss against speed: sliding, rolling and total, tribo-dynamic against
     quasi-static (like the paper's Fig. 4a). ``dynamic``/``quasi_static``: dicts with keys
     "total", "sliding", "rolling" (W)."""
@@ -103,6 +121,7 @@ def plot_power_loss(speeds_rpm, dynamic, quasi_static, path):
     for key, ls in styles.items():
         ax.plot(speeds_rpm, dynamic[key], ls, color="C0", label=f"{key}, tribo-dynamic")
         ax.plot(speeds_rpm, quasi_static[key], ls, color="C1", label=f"{key}, quasi-static")
+    _mark_flagged(ax, speeds_rpm, dynamic["total"], ok)
     _paper_points(ax)
     ax.set(xlabel="gear 1 speed (rpm)", ylabel="Φ̄ (W)", title="Mesh power loss")
     ax.grid(alpha=0.3)
@@ -113,12 +132,13 @@ def plot_power_loss(speeds_rpm, dynamic, quasi_static, path):
     return Path(path)
 
 
-def plot_efficiency(speeds_rpm, dynamic, quasi_static, path):
+def plot_efficiency(speeds_rpm, dynamic, quasi_static, path, ok=None):
     """Mesh efficiency Ψ (%) against speed, tribo-dynamic against quasi-static (paper's Fig. 4b)."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(speeds_rpm, 100 * np.asarray(dynamic), "-", label="tribo-dynamic")
     ax.plot(speeds_rpm, 100 * np.asarray(quasi_static), "--", label="quasi-static")
+    _mark_flagged(ax, speeds_rpm, 100 * np.asarray(dynamic), ok)
     _paper_points(ax)
     ax.set(xlabel="gear 1 speed (rpm)", ylabel="Ψ (%)", title="Mesh efficiency")
     ax.grid(alpha=0.3)

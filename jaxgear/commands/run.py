@@ -100,14 +100,14 @@ def run(args: argparse.Namespace) -> int:
     t_all = time.perf_counter() - t0
 
     _write_csv(out / "sweep.csv", speeds, td, qs)
-    plot_dte_rms(speeds, td.dte_rms, out / "dte_rms.png")
+    plot_dte_rms(speeds, td.dte_rms, out / "dte_rms.png", ok=td.converged)
     parts = lambda r: {
         "total": r.power_loss,
         "sliding": r.power_loss_sliding,
         "rolling": r.power_loss_rolling,
     }
-    plot_power_loss(speeds, parts(td), parts(qs), out / "power_loss.png")
-    plot_efficiency(speeds, td.efficiency, qs.efficiency, out / "efficiency.png")
+    plot_power_loss(speeds, parts(td), parts(qs), out / "power_loss.png", ok=td.converged)
+    plot_efficiency(speeds, td.efficiency, qs.efficiency, out / "efficiency.png", ok=td.converged)
     summary = _summary(speeds, td, qs, fid, args, t_td, t_all)
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     print(json.dumps(summary["headline"], indent=1))
