@@ -11,8 +11,9 @@ NOTEBOOK = Path(__file__).resolve().parents[1] / "notebooks" / "calibration.ipyn
 
 @pytest.mark.slow  # ~2 min on the shared 2-core CPU (three compiled sweeps)
 def test_calibration_notebook_executes():
-    nbformat = pytest.importorskip("nbformat")
-    nbclient = pytest.importorskip("nbclient")
+    import nbclient
+    import nbformat
+
     nb = nbformat.read(NOTEBOOK, as_version=4)
     # Run from the repository root so that the kernel imports this checkout's jaxgear.
     client = nbclient.NotebookClient(
