@@ -17,7 +17,15 @@ def _pair(**kw):
 def test_issue_example_constructs():
     pair = _pair()
     assert pair.teeth == (23, 47)
-    assert 1.0 < float(jg.gear_geometry(pair).contact_ratio) < 2.0
+    # Textbook contact ratio of the unshifted pair, written out here:
+    # [√(ra1² − rb1²) + √(ra2² − rb2²) − a sin α] / (π m cos α).
+    m, a = 4e-3, math.radians(25)
+    rb = [m * z / 2 * math.cos(a) for z in (23, 47)]
+    ra = [m * (z / 2 + 1) for z in (23, 47)]
+    path = sum(math.sqrt(r**2 - b**2) for r, b in zip(ra, rb)) - m * 35 * math.sin(a)
+    assert float(jg.gear_geometry(pair).contact_ratio) == pytest.approx(
+        path / (math.pi * m * math.cos(a)), rel=1e-12
+    )
 
 
 @pytest.mark.parametrize(
