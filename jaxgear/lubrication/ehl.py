@@ -43,8 +43,10 @@ from .._validation import (
     is_concrete,
 )
 from ..gear.geometry import hertz_half_width, hertz_pressure
+from . import asperity as asperity_mod
 from . import deformation as deformation_mod
 from . import rheology
+from . import thermal as thermal_mod
 from .lubricant import Lubricant
 from .reynolds import (
     fischer_burmeister,
@@ -56,6 +58,7 @@ VISCOSITY_MODELS = ("roelands", "barus")
 COMPRESSIBILITY_MODELS = ("dowson_higginson", "incompressible")
 SHEAR_MODELS = ("newtonian", "eyring_paper", "eyring_exact")
 DEFORMATION_METHODS = ("dense", "fft", "auto")
+MIXED_MODELS = ("deterministic", "statistical")
 
 _LOG_VISCOSITY_CAP = 500.0  # cap on ln(η/η0): keeps iterates finite (η/η0 ≤ e^500)
 _FLOOR_FRACTION = 1e-3  # smooth film floor inside ε, relative to the reference film
@@ -144,6 +147,26 @@ class EHLModel(eqx.Module):
         above
             1025 nodes).
         wedge_order: upwind order of the wedge term (1 or 2).
+        thermal: thermal EHL (REFERENCE §5): the film's mean temperature (paper Eq. 8 profile, with
+            convection) and both surface temperatures (Jaeger, paper Eq. 9) from the heat flux of
+            Eq. 12, viscosity and density re-evaluated at the film temperature, iterated
+            ``thermal_iterations`` times (Picard, warm-started). False skips all of it.
+        boundary_friction: μb of asperity contact (paper: 0.1).
+        contact_threshold: a node is in asperity contact where h is below this fraction of the
+            smooth central-film estimate (there the Poiseuille flow has vanished: ε ∝ h³ < 1e-7 of
+            its smooth value, and Reynolds reduces to paper Eq. 4b/4c). Smooth indicator.
+        roughness_steps: continuation steps in the roughness amplitude (1/n … 1) of a cold mixed
+            solve, which starts from the smooth solution.
+        mixed: how rough surfaces are treated. "deterministic": the roughness profiles in the film
+            (paper Eq. 5) with the unified Reynolds equation (Hu-Zhu); needs Δx ≲ 2 µm and
+            converges where the film parameter λ = h/σ is not far below ~0.5 (deep mixed
+            lubrication is reported as not converged). "statistical": the mean film with the
+            Greenwood-Tripp asperity pressure p_a(h) (``asperity.py``) added to the load and the
+            deformation (Johnson-Greenwood-Poon load sharing), iterated with the temperatures;
+            robust down to λ → 0; it needs only the composite roughness σ.
+        asperity_density_product, asperity_slope_ratio: nβσ and σ/β of the statistical model
+            [typical values for ground steel: 0.05, 0.01].
+        asperity_relaxation: under-relaxation of the asperity-pressure update (statistical).
     """
 
     n_nodes: int = eqx.field(static=True, default=257)
@@ -161,6 +184,15 @@ class EHLModel(eqx.Module):
     warm_iterations: int = eqx.field(static=True, default=12)
     deformation: str = eqx.field(static=True, default="auto")
     wedge_order: int = eqx.field(static=True, default=2)
+    thermal: bool = eqx.field(static=True, default=False)
+    thermal_iterations: int = eqx.field(static=True, default=4)
+    boundary_friction: float = eqx.field(static=True, default=0.1)
+    contact_threshold: float = eqx.field(static=True, default=5e-3)
+    roughness_steps: int = eqx.field(static=True, default=4)
+    mixed: str = eqx.field(static=True, default="deterministic")
+    asperity_density_product: float = eqx.field(static=True, default=0.05)
+    asperity_slope_ratio: float = eqx.field(static=True, default=0.01)
+    asperity_relaxation: float = eqx.field(static=True, default=0.5)
 
     def __check_init__(self):
         if not isinstance(self.n_nodes, int) or self.n_nodes < 17:
@@ -177,9 +209,27 @@ class EHLModel(eqx.Module):
         check_choice("EHLModel.shear", self.shear, SHEAR_MODELS)
         check_choice("EHLModel.deformation", self.deformation, DEFORMATION_METHODS)
         check_choice("EHLModel.wedge_order", self.wedge_order, (1, 2))
+        check_choice("EHLModel.mixed", self.mixed, MIXED_MODELS)
+        check_range("EHLModel.asperity_density_product", self.asperity_density_product, 1e-4, 1.0)
+        check_range("EHLModel.asperity_slope_ratio", self.asperity_slope_ratio, 1e-6, 1.0)
+        check_range("EHLModel.asperity_relaxation", self.asperity_relaxation, 0.01, 1.0)
         check_range("EHLModel.fb_smoothing", self.fb_smoothing, 0.0, 1e-2, low_inclusive=False)
         check_range("EHLModel.tolerance", self.tolerance, 0.0, 1e-2, low_inclusive=False)
-        for name in ("max_iterations", "continuation_steps", "warm_iterations"):
+        if not isinstance(self.thermal, bool):
+            raise ValueError(
+                f"EHLModel.thermal = {self.thermal!r} is not valid; valid: True, False"
+            )
+        check_range("EHLModel.boundary_friction", self.boundary_friction, 0.0, 1.0)
+        check_range(
+            "EHLModel.contact_threshold", self.contact_threshold, 1e-4, 0.1, low_inclusive=True
+        )
+        for name in (
+            "max_iterations",
+            "continuation_steps",
+            "warm_iterations",
+            "thermal_iterations",
+            "roughness_steps",
+        ):
             v = getattr(self, name)
             if not isinstance(v, int) or v < 1:
                 raise ValueError(f"EHLModel.{name} = {v!r} is out of range; valid range: [1, inf)")
@@ -203,19 +253,29 @@ class EHLSolution(eqx.Module):
         x: node positions, m, (N,) (x = 0 at the Hertz centre, entrainment towards +x).
         p: pressure, Pa. h: film thickness, m. density: ρ, kg/m³. viscosity: η, Pa s.
         shear_viscosity: η_s of the shear model (η, η* or τ h/us), Pa s.
-        temperature: film temperature, K (the inlet temperature: isothermal).
-        heat_flux, heat_flux_sliding, heat_flux_rolling: Q of paper Eq. (12) and its two parts,
-        W/m².
+        temperature: mean film temperature ϕm at the nodes, K (the inlet temperature: isothermal).
+        surface_temperature1, surface_temperature2: surface temperatures of gear 1 and 2, K.
+        heat_partition: ϑ = Q1/Q, share of the heat conducted into gear 1 (½ isothermal).
+        heat_flux: Q of paper Eq. (12), W/m² = heat_flux_sliding (fluid shear) + heat_flux_rolling
+            (Poiseuille) + heat_flux_asperity (μb p |us| in contact).
+        contact: asperity-contact indicator at the nodes, 0 … 1 (smooth; deterministic mixed).
+        asperity_pressure: statistical asperity pressure at the nodes, Pa (included in p).
         h_min, h_central: minimum and central (x = 0) film, m. h0: film offset, m. p_max: Pa.
         (In the cavitated outlet the gap is partly filled: the shear terms are weighted by the fill
         fraction q/(um ρ h), q the mass flux through x = 0, as in a JFO/Elrod streak model.)
         friction_sliding: Fs = ∫ η_s (u2 − u1)/h dx, N/m (paper Eq. 15, fluid part; sign of Eq. 15).
-        friction_rolling: Fr = ∫ (h/2) ∂p/∂x dx, N/m (paper Eq. 15).
-        damping: cm = ∫ η_s/h dx, N s/m² (paper Eq. 13 per unit width).
-        power_loss, power_loss_sliding, power_loss_rolling: ∫ Q dx and its parts, W/m.
+            It includes the boundary friction ∫ μb p dx of asperity contact, friction_asperity.
+        friction_rolling: Fr = ∫ (h/2) ∂p/∂x dx over the fluid, N/m (paper Eq. 15).
+        damping: cm = ∫ η_s/h dx over the fluid, N s/m² (paper Eq. 13 per unit width).
+        power_loss: ∫ Q dx, W/m; power_loss_sliding: fluid shear plus asperity friction;
+            power_loss_rolling: Poiseuille part; power_loss_asperity: the asperity part alone.
+        contact_fraction: share of the Hertz zone |x| ≤ b in asperity contact.
+        contact_load: ∫ p dx over contact nodes, N/m (``contact_load_share``: its share).
         load_error: (∫ p dx − w')/w'.
         hertz_half_width (m), hertz_pressure (Pa), moes_m, moes_l: scales of the contact.
         converged, residual (‖F‖∞ of the fine-grid system), iterations (Newton, all levels).
+        thermal_residual: largest change of the film temperature in the last thermal (Picard)
+            iteration, K (0 isothermal).
     """
 
     x: Float[Array, " N"]
@@ -225,19 +285,29 @@ class EHLSolution(eqx.Module):
     viscosity: Float[Array, " N"]
     shear_viscosity: Float[Array, " N"]
     temperature: Float[Array, " N"]
+    surface_temperature1: Float[Array, " N"]
+    surface_temperature2: Float[Array, " N"]
+    heat_partition: Float[Array, " N"]
     heat_flux: Float[Array, " N"]
     heat_flux_sliding: Float[Array, " N"]
     heat_flux_rolling: Float[Array, " N"]
+    heat_flux_asperity: Float[Array, " N"]
+    contact: Float[Array, " N"]
+    asperity_pressure: Float[Array, " N"]
     h_min: Float[Array, ""]
     h_central: Float[Array, ""]
     h0: Float[Array, ""]
     p_max: Float[Array, ""]
     friction_sliding: Float[Array, ""]
+    friction_asperity: Float[Array, ""]
     friction_rolling: Float[Array, ""]
     damping: Float[Array, ""]
     power_loss: Float[Array, ""]
     power_loss_sliding: Float[Array, ""]
     power_loss_rolling: Float[Array, ""]
+    power_loss_asperity: Float[Array, ""]
+    contact_fraction: Float[Array, ""]
+    contact_load: Float[Array, ""]
     load_error: Float[Array, ""]
     hertz_half_width: Float[Array, ""]
     hertz_pressure: Float[Array, ""]
@@ -246,6 +316,22 @@ class EHLSolution(eqx.Module):
     converged: Bool[Array, ""]
     residual: Float[Array, ""]
     iterations: Int[Array, ""]
+    thermal_residual: Float[Array, ""]
+
+    @property
+    def temperatures(self):
+        """(film mean, surface 1, surface 2) temperatures at the nodes, K, shape (3, N)."""
+        return jnp.stack([self.temperature, self.surface_temperature1, self.surface_temperature2])
+
+    @property
+    def fluid_pressure(self):
+        """Pressure carried by the fluid, Pa (p minus the statistical asperity pressure)."""
+        return self.p - self.asperity_pressure
+
+    @property
+    def contact_load_share(self):
+        """Share of the load carried by asperity contact."""
+        return self.contact_load / jnp.maximum(jnp.sum(self.p) * (self.x[1] - self.x[0]), 1e-300)
 
     @property
     def rho_h(self):
@@ -260,7 +346,10 @@ class _Inputs(eqx.Module):
     lubricant: Lubricant
     rho_h_previous: Float[Array, " N"]  # kg/m², on this solve's nodes
     inv_time_step: Float[Array, ""]  # 1/Δt, 1/s (0: steady)
-    film_offset: Float[Array, " N"]  # m, added to h (roughness terms of issue 4; zero here)
+    film_offset: Float[Array, " N"]  # m, added to h: −(S1 + S2), the roughness of paper Eq. (5)
+    temperature_rise: Float[Array, " N"]  # K, mean film temperature above the inlet, at the nodes
+    asperity_pressure: Float[Array, " N"]  # Pa, statistical asperity pressure at the nodes
+    roughness: Float[Array, ""]  # m, composite roughness σ (statistical mixed model)
 
 
 # -------------------------------------------------------------------------------------------------
@@ -378,6 +467,11 @@ class _Level(eqx.Module):
     rho_nodes: Array  # ρ(0, T)/ρ0 at the nodes
     offset: Array  # dimensionless film offset
     rho_h_prev: Array  # dimensionless ρ̄H of the previous step
+    asperity: Array  # dimensionless asperity pressure (held fixed within a Newton solve)
+
+    def with_roughness(self, factor):
+        """The same system with the film offset (roughness) scaled by ``factor``."""
+        return eqx.tree_at(lambda lev: lev.offset, self, self.offset * factor)
 
     def deformation(self, p):
         if self.model.use_fft(self.n):
@@ -386,7 +480,7 @@ class _Level(eqx.Module):
 
     def film(self, u):
         p, h0 = u[: self.n], u[self.n]
-        return h0 + 0.5 * self.x**2 + self.offset + self.deformation(p)
+        return h0 + 0.5 * self.x**2 + self.offset + self.deformation(p + self.asperity)
 
     def local(self, p, h, s):
         """Node-wise FB residual as a function of P and H (banded dependence, bandwidth −2…+1)."""
@@ -419,7 +513,7 @@ class _Level(eqx.Module):
         return f.at[0].set(p[0]).at[-1].set(p[-1])
 
     def load_row(self, p):
-        return (self.spacing * jnp.sum(p) - 0.5 * jnp.pi) / (0.5 * jnp.pi)
+        return (self.spacing * jnp.sum(p + self.asperity) - 0.5 * jnp.pi) / (0.5 * jnp.pi)
 
     def residual(self, u, s=1.0):
         p = u[: self.n]
@@ -464,19 +558,25 @@ def _make_level(model: EHLModel, inp: _Inputs, sc: _Scales, n: int, fine_n: int)
     kernel = deformation_mod.influence_matrix(n, spacing)
     r = inp.contact.reduced_radius
     h_scale = sc.b**2 / r
-    t = jnp.full((n,), inp.contact.inlet_temperature)
     if n == fine_n:
         offset = inp.film_offset / h_scale
         prev = inp.rho_h_previous / (sc.rho0 * h_scale)
+        rise = inp.temperature_rise
+        asperity = inp.asperity_pressure / sc.ph
     else:
         x_fine, _ = _grid(sc, fine_n)
         offset = jnp.interp(x, x_fine, inp.film_offset) / h_scale
         prev = jnp.interp(x, x_fine, inp.rho_h_previous) / (sc.rho0 * h_scale)
+        rise = jnp.interp(x, x_fine, inp.temperature_rise)
+        asperity = jnp.interp(x, x_fine, inp.asperity_pressure) / sc.ph
+    t = inp.contact.inlet_temperature + rise
     lub = inp.lubricant
     log_eta0 = lub.log_base_viscosity(t)
     alpha = rheology.roelands_pressure_viscosity_coefficient(log_eta0, lub.roelands_z)
     rho = lub.density_at(0.0, t, compressible=False) / sc.rho0
-    return _Level(model, n, inp, sc, x, spacing, kernel, t, log_eta0, alpha, rho, offset, prev)
+    return _Level(
+        model, n, inp, sc, x, spacing, kernel, t, log_eta0, alpha, rho, offset, prev, asperity
+    )
 
 
 # -------------------------------------------------------------------------------------------------
@@ -618,8 +718,8 @@ def _warm_start(fine: _Level, init_x, init_p, init_h0):
     return jnp.concatenate([p, h0[None]])
 
 
-@functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1))
-def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_h0):
+@functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2))
+def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, init_p, init_h0):
     """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats.
 
     The fine-grid Newton loop appears once in the program: a warm solve is a scan over two attempts
@@ -641,7 +741,22 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
             row = jnp.clip(kind - 1, 0, n_cold - 1)
             # the coarse grids are built here, inside the branch: a warm start never pays for them
             _, levels = _levels(model, inp)
-            return _cold_start(model, levels, schedules[row])
+            if mixed != "deterministic":
+                return _cold_start(model, levels, schedules[row])
+            # mixed: the smooth problem first, then continuation in the roughness amplitude on the
+            # fine grid (coarse grids cannot resolve the roughness anyway)
+            smooth = [lev.with_roughness(0.0) for lev in levels]
+            start, k0 = _cold_start(model, smooth, schedules[row])
+            steps = model.roughness_steps
+            factors = jnp.arange(1, steps, dtype=dtype) / steps
+
+            def rough_step(carry, r):
+                u, k = carry
+                u_new, _, k_new, _ = _newton(fine.with_roughness(r), u, 1.0, model.max_iterations)
+                return (u_new, k + k_new), None
+
+            (start, k0), _ = jax.lax.scan(rough_step, (start, k0), factors)
+            return start, k0
 
         def keep(_):
             return u, jnp.asarray(0)
@@ -653,15 +768,18 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
         u1, res1, k1, ok1 = _newton(fine, start, 1.0, max_iter)
         u1 = jnp.where(ok, u, u1)
         res1 = jnp.where(ok, res, res1)
-        # a closed film is a failure: try the next attempt
-        ok1 = (ok | ok1) & (jnp.min(fine.film(u1)) > 0.0)
+        # smooth EHL: a closed film is a failure: try the next attempt (mixed: it is contact)
+        ok1 = ok | ok1
+        if mixed == "smooth":
+            ok1 = ok1 & (jnp.min(fine.film(u1)) > 0.0)
         return (u1, res1, it + k0 + k1, ok1), None
 
     init = (u_warm, jnp.asarray(jnp.inf, dtype=dtype), jnp.asarray(0), jnp.asarray(False))
     (u, res, it, ok), _ = jax.lax.scan(attempt, init, kinds)
     # a closed (non-positive) film is not a smooth-EHL solution, however small the residual: report
     # it
-    ok = ok & (jnp.min(fine.film(u)) > 0.0)
+    if mixed == "smooth":
+        ok = ok & (jnp.min(fine.film(u)) > 0.0)
     finite = jnp.all(jnp.isfinite(u))
     fallback = _hertz_start(fine)
     u = jnp.where(finite, u, fallback)
@@ -671,10 +789,10 @@ def _solve_core(model: EHLModel, warm: bool, inp: _Inputs, init_x, init_p, init_
 
 
 @_solve_core.defjvp
-def _solve_core_jvp(model, warm, primals, tangents):
+def _solve_core_jvp(model, warm, mixed, primals, tangents):
     inp, init_x, init_p, init_h0 = primals
     d_inp = tangents[0]
-    u, res, it, ok = _solve_core(model, warm, inp, init_x, init_p, init_h0)
+    u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0)
 
     def fine_residual(theta):
         return _fine_level(model, theta)[1].residual(u, 1.0)
@@ -686,7 +804,14 @@ def _solve_core_jvp(model, warm, primals, tangents):
     return (u, res, it, ok), (du, z, z, z)
 
 
-def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
+def _contact_indicator(model: EHLModel, sc: _Scales, big_h):
+    """Smooth share (0 … 1) of asperity contact at each node: 1 where the dimensionless film H is
+    below ``contact_threshold`` × the smooth central-film estimate, 0 above twice that."""
+    hc = model.contact_threshold * sc.h_ref
+    return 0.5 * (1.0 - jnp.tanh(4.0 * (big_h - 1.5 * hc) / hc))
+
+
+def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> EHLSolution:
     sc, lev = _fine_level(model, inp)
     c, lub = inp.contact, inp.lubricant
     n = lev.n
@@ -705,23 +830,35 @@ def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
     abs_us = jnp.sqrt(sc.us**2 + (1e-6 * sc.um) ** 2)
     log_s = log_eta + jnp.log(abs_us / (lub.eyring_stress * h_eff))
     eta_s = jnp.exp(log_eta + _log_shear_factor(model, log_s))
+    # asperity contact (paper Eq. 4b/4c, 12, 15): boundary friction μb p on closed nodes
+    if mixed == "deterministic":
+        contact = _contact_indicator(model, sc, big_h)
+    else:
+        contact = jnp.zeros_like(big_h)
+    p_asp = inp.asperity_pressure  # statistical asperity pressure (zero otherwise)
+    fluid = 1.0 - contact
     dpdx = jnp.gradient(p_dim, dx)
     # Fill fraction of the cavitated outlet: the mass flux through x = 0 carried as Couette streaks.
-    rho_h = rho * h
-    eps_flux = rho * h**3 / (12.0 * eta_s) * dpdx
+    rho_h = rho * h_eff
+    eps_flux = rho * h_eff**3 / (12.0 * eta_s) * dpdx
     q = jnp.interp(0.0, x, rho_h * sc.um - eps_flux)
-    fill = jnp.where(x > 0.0, jnp.minimum(1.0, q / (sc.um * rho_h)), 1.0)
+    fill = jnp.where(x > 0.0, jnp.clip(q / (sc.um * rho_h), 0.0, 1.0), 1.0)
     weights = jnp.full((n,), dx).at[0].set(0.5 * dx).at[-1].set(0.5 * dx)
-    q_slide = fill * eta_s * sc.us**2 / h_eff  # paper Eq. (12), sliding part
+    q_slide = fluid * fill * eta_s * sc.us**2 / h_eff  # paper Eq. (12), sliding part
+    q_asp = model.boundary_friction * (contact * p_dim + p_asp) * abs_us  # paper Eq. (12), h = 0
     # Poiseuille terms on cell faces, as the Reynolds discretisation has them (flow coefficient
     # averaged to the face, pressure gradient by the face difference)
-    flow = h_eff**3 / (12.0 * eta_s)
+    flow = fluid * h_eff**3 / (12.0 * eta_s)
     dp_face = jnp.diff(p_dim) / dx
     q_roll_face = 0.5 * (flow[1:] + flow[:-1]) * dp_face**2  # paper Eq. (12), rolling part
     q_roll = 0.5 * (jnp.pad(q_roll_face, (1, 0)) + jnp.pad(q_roll_face, (0, 1)))
-    fs = jnp.sum(weights * fill * eta_s * (c.u2 - c.u1) / h_eff)  # paper Eq. (15)
-    fr = jnp.sum(0.25 * (h[1:] + h[:-1]) * jnp.diff(p_dim))  # paper Eq. (15): ∫ (h/2) ∂p/∂x dx
-    cm = jnp.sum(weights * fill * eta_s / h_eff)  # paper Eq. (13) per unit width
+    sign = (c.u2 - c.u1) / abs_us
+    # paper Eq. (15): Fs = Σ μb p (asperity) + Σ η*(u2 − u1)/h (fluid); Fr = Σ (h/2) ∂p/∂x (fluid)
+    fs_fluid = jnp.sum(weights * fluid * fill * eta_s * (c.u2 - c.u1) / h_eff)
+    fs_asp = jnp.sum(weights * model.boundary_friction * (contact * p_dim + p_asp)) * sign
+    h_face = 0.5 * (h[1:] + h[:-1]) * 0.5 * (fluid[1:] + fluid[:-1])
+    fr = jnp.sum(0.5 * h_face * jnp.diff(p_dim))
+    cm = jnp.sum(weights * fluid * fill * eta_s / h_eff)  # paper Eq. (13) per unit width
     # sub-grid minimum film by a parabola through the smallest node and its neighbours
     i = jnp.clip(jnp.argmin(big_h), 1, n - 2)
     hm, h_0, hp = big_h[i - 1], big_h[i], big_h[i + 1]
@@ -729,28 +866,50 @@ def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
     safe = jnp.where(curv > 0, curv, 1.0)
     h_min = jnp.where(curv > 0, h_0 - (hp - hm) ** 2 / (8.0 * safe), h_0) * h_scale
     h_central = jnp.interp(0.0, lev.x, big_h) * h_scale
-    load_err = jnp.sum(weights * p_dim) / c.load_per_width - 1.0
+    load_err = jnp.sum(weights * (p_dim + p_asp)) / c.load_per_width - 1.0
+    hertz_zone = (jnp.abs(lev.x) <= 1.0).astype(p_dim.dtype)
+    p_loss_slide = jnp.sum(weights * q_slide)
+    p_loss_asp = jnp.sum(weights * q_asp)
+    p_loss_roll = jnp.sum(q_roll_face) * dx
+    t_in = jnp.broadcast_to(c.inlet_temperature, t.shape)
+    if mixed == "statistical":
+        area = asperity_mod.contact_area_ratio(
+            jnp.maximum(h, 0.0) + jnp.minimum(h, 0.0), inp.roughness, model.asperity_density_product
+        )
+        fraction = jnp.sum(hertz_zone * area) / jnp.sum(hertz_zone)
+    else:
+        fraction = jnp.sum(hertz_zone * contact) / jnp.sum(hertz_zone)
     return EHLSolution(
         x=x,
-        p=p_dim,
+        p=p_dim + p_asp,
         h=h,
         density=rho,
         viscosity=eta,
         shear_viscosity=eta_s,
         temperature=t,
-        heat_flux=q_slide + q_roll,
+        surface_temperature1=t_in,
+        surface_temperature2=t_in,
+        heat_partition=jnp.full_like(t, 0.5),
+        heat_flux=q_slide + q_roll + q_asp,
         heat_flux_sliding=q_slide,
         heat_flux_rolling=q_roll,
+        heat_flux_asperity=q_asp,
+        contact=contact,
+        asperity_pressure=p_asp,
         h_min=h_min,
         h_central=h_central,
         h0=u[n] * h_scale,
-        p_max=jnp.max(p_dim),
-        friction_sliding=fs,
+        p_max=jnp.max(p_dim + p_asp),
+        friction_sliding=fs_fluid + fs_asp,
+        friction_asperity=fs_asp,
         friction_rolling=fr,
         damping=cm,
-        power_loss=jnp.sum(weights * q_slide) + jnp.sum(q_roll_face) * dx,
-        power_loss_sliding=jnp.sum(weights * q_slide),
-        power_loss_rolling=jnp.sum(q_roll_face) * dx,
+        power_loss=p_loss_slide + p_loss_asp + p_loss_roll,
+        power_loss_sliding=p_loss_slide + p_loss_asp,
+        power_loss_rolling=p_loss_roll,
+        power_loss_asperity=p_loss_asp,
+        contact_fraction=fraction,
+        contact_load=jnp.sum(weights * (contact * p_dim + p_asp)),
         load_error=load_err,
         hertz_half_width=sc.b,
         hertz_pressure=sc.ph,
@@ -759,13 +918,132 @@ def _postprocess(model: EHLModel, inp: _Inputs, u, res, it, ok) -> EHLSolution:
         converged=ok > 0.5,
         residual=res,
         iterations=jax.lax.stop_gradient(it).astype(jnp.int32),
+        thermal_residual=jnp.zeros_like(res),
     )
 
 
+def _temperatures(inp: _Inputs, sol: EHLSolution, solids, transient=None):
+    """Film and surface temperature rises of a solution's heat source (REFERENCE §5).
+
+    ``transient``: None (steady Jaeger surfaces, quasi-steady film) or (response, film_previous,
+    dt): the surfaces' diagonal responses ((offset1, gain1), (offset2, gain2)) of one transient step
+    (paper Eq. 9 with memory) and the film's mean temperature rise at the previous step."""
+    lub, c = inp.lubricant, inp.contact
+    response, film_previous, dt = (None, None, None) if transient is None else transient
+    return thermal_mod.solve_contact_temperatures(
+        sol.x,
+        sol.heat_flux,
+        jnp.maximum(sol.h, 0.0),
+        c.u1,
+        c.u2,
+        solids[0],
+        solids[1],
+        sol.density,
+        lub.specific_heat,
+        lub.thermal_conductivity,
+        convection=True,
+        surface_response=response,
+        inlet_temperature=0.0,
+        previous_film_mean=film_previous,
+        dt=dt,
+    )
+
+
+def _with_temperatures(sol: EHLSolution, temps, inlet, thermal_residual) -> EHLSolution:
+    return eqx.tree_at(
+        lambda s: (
+            s.surface_temperature1,
+            s.surface_temperature2,
+            s.heat_partition,
+            s.thermal_residual,
+        ),
+        sol,
+        (inlet + temps.surface1, inlet + temps.surface2, temps.partition, thermal_residual),
+    )
+
+
+def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transient=None):
+    """One solve (steady or one transient step); thermal when ``model.thermal``; with the
+    statistical asperity pressure when ``mixed == "statistical"``.
+
+    Returns (solution, temperatures or None)."""
+    u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0)
+    sol = _postprocess(model, mixed, inp, u, res, it, ok)
+    statistical = mixed == "statistical"
+    if not (model.thermal or statistical):
+        return sol, None
+    n_outer = model.thermal_iterations if model.thermal else 0
+    if statistical:
+        n_outer = max(n_outer, _ASPERITY_ITERATIONS)
+    ph = sol.hertz_pressure
+    e_red = inp.contact.e_reduced
+
+    def asperity_of(sol):
+        return asperity_mod.asperity_pressure(
+            sol.h,
+            inp.roughness,
+            e_red,
+            model.asperity_density_product,
+            model.asperity_slope_ratio,
+        )
+
+    # Outer (Picard) iteration: Reynolds at fixed temperatures and asperity pressures (Newton, warm
+    # started), then the temperatures of its heat source and the asperity pressure of its film.
+    def picard(carry, _):
+        sol, inp_k, _ = carry
+        changes = []
+        inp_next = inp_k
+        if model.thermal:
+            temps = _temperatures(inp_k, sol, solids, transient)
+            rise = _safe_rise(temps.film_mean)
+            inp_next = eqx.tree_at(lambda i: i.temperature_rise, inp_next, rise)
+        if statistical:
+            beta = model.asperity_relaxation
+            target = jnp.where(jnp.isfinite(sol.h), asperity_of(sol), 0.0)
+            target = jnp.minimum(target, 20.0 * ph)
+            pa = (1.0 - beta) * inp_k.asperity_pressure + beta * target
+            changes.append(jnp.max(jnp.abs(target - inp_k.asperity_pressure)) / ph)
+            inp_next = eqx.tree_at(lambda i: i.asperity_pressure, inp_next, pa)
+        u, res, it, ok = _solve_core(
+            model, True, mixed, inp_next, sol.x, sol.fluid_pressure, sol.h0
+        )
+        new = _postprocess(model, mixed, inp_next, u, res, it, ok)
+        new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol.iterations)
+        change = changes[0] if changes else jnp.zeros_like(res)
+        return (new, inp_next, change), None
+
+    init = (sol, inp, jnp.zeros_like(res))
+    (sol, inp_last, pa_change), _ = jax.lax.scan(picard, init, None, length=n_outer)
+    if statistical:
+        # the asperity pressure of the final film agrees with the one the film was solved with
+        pa_ok = jnp.max(jnp.abs(asperity_of(sol) - inp_last.asperity_pressure)) <= 1e-3 * ph
+        sol = eqx.tree_at(lambda s: s.converged, sol, sol.converged & pa_ok)
+    if not model.thermal:
+        return sol, None
+    temps = _temperatures(inp_last, sol, solids, transient)
+    temps = jax.tree_util.tree_map(_safe_rise, temps)
+    change = jnp.max(jnp.abs(temps.film_mean - inp_last.temperature_rise))
+    change = jnp.where(jnp.isfinite(change), change, jnp.finfo(change.dtype).max)
+    # thermally converged: the last Picard step moved the film temperature by < 1 % of its largest
+    # rise (or < 0.05 K)
+    thermal_ok = change <= jnp.maximum(0.01 * jnp.max(jnp.abs(temps.film_mean)), 0.05)
+    sol = eqx.tree_at(lambda s: s.converged, sol, sol.converged & thermal_ok)
+    return _with_temperatures(sol, temps, inp.contact.inlet_temperature, change), temps
+
+
+_ASPERITY_ITERATIONS = 12  # outer iterations of the statistical asperity pressure (β = ½: 2^-12)
+_MAX_RISE = 1500.0  # K: a temperature rise beyond this only comes from a failed solve
+
+
+def _safe_rise(t):
+    """Temperatures of a failed solve are kept finite and bounded (the failure is reported by
+    ``converged``), so that the next Picard step and the outputs never carry NaN."""
+    return jnp.where(jnp.isfinite(t), jnp.clip(t, -_MAX_RISE, _MAX_RISE), 0.0)
+
+
 @eqx.filter_jit
-def _solve_jit(model, warm, inp, init_x, init_p, init_h0):
-    u, res, it, ok = _solve_core(model, warm, inp, init_x, init_p, init_h0)
-    return _postprocess(model, inp, u, res, it, ok)
+def _solve_jit(model, warm, mixed, inp, init_x, init_p, init_h0, solids):
+    return _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids)[0]
 
 
 def solve_ehl(
@@ -777,33 +1055,47 @@ def solve_ehl(
     initial: EHLSolution | None = None,
     previous: EHLSolution | None = None,
     time_step=None,
+    displacement=None,
+    solids=None,
+    temperature_rise=None,
 ) -> EHLSolution:
-    """Solve a smooth isothermal line-contact EHL problem (steady, or one backward-Euler step).
+    """Solve a line-contact EHL problem: smooth or mixed (rough), isothermal or thermal, steady or
+    one backward-Euler step.
 
     Args:
         contact: the LineContact (SI).
         lubricant: the Lubricant.
         model: static EHLModel (default ``EHLModel()``: 257 nodes, Roelands, Dowson-Higginson,
-            paper Eyring).
-        surfaces: must be ``None`` (smooth surfaces; mixed lubrication is issue 4).
+            paper Eyring, isothermal). ``EHLModel(thermal=True)`` adds the temperatures.
+        surfaces: ``None`` (smooth) or a :class:`~jaxgear.lubrication.roughness.Surfaces`: mixed
+            lubrication with the roughness S1 + S2 in the film (paper Eq. 5), asperity contact
+            where the film closes (Hu-Zhu unified Reynolds, paper Eq. 4b/4c) and boundary friction
+            μb p there. The grid must resolve the roughness (Δx ≲ 1-3 µm).
         initial: a previous EHLSolution to warm-start from (any contact; its p(x) is interpolated
-        and
-            its h0 reused). A failed warm start falls back to a cold solve.
+            and its h0 reused). A failed warm start falls back to a cold solve.
         previous: the solution at the previous time step; with ``time_step`` Δt (s) the squeeze term
             ∂(ρh)/∂t ≈ (ρh − ρh_prev)/Δt is included (backward Euler). ρh_prev is interpolated onto
             this solve's nodes (same nodes when the contact's Hertz half-width is unchanged).
         time_step: Δt, s (required with ``previous``).
+        displacement: (d1, d2), m: how far each surface has moved, ∫ uj dt; the roughness is
+            Sj = scale · zj(x − xj0 − dj). Default (0, 0).
+        solids: (Material of gear 1, Material of gear 2) for the surface temperatures (default:
+            steel, REFERENCE §4). Used only when ``model.thermal``.
+        temperature_rise: starting film temperature rise at the nodes (K), e.g. from a previous
+            time step; default zero. Isothermal: the film is held at this temperature field.
 
     Returns:
         EHLSolution (SI, per unit width), with ``converged``, ``residual`` and ``iterations``.
     """
+    from ..lubrication.roughness import Surfaces
+    from ..material import steel
+
     model = EHLModel() if model is None else model
     if not isinstance(model, EHLModel):
         raise ValueError(f"model = {model!r} is not valid; valid: an EHLModel")
-    if surfaces is not None:
+    if surfaces is not None and not isinstance(surfaces, Surfaces):
         raise ValueError(
-            "surfaces = (rough surfaces) is not valid; valid: None (smooth EHL). Mixed lubrication "
-            "with roughness is not implemented yet"
+            f"surfaces = {type(surfaces).__name__} is not valid; valid: None or a Surfaces"
         )
     if not isinstance(contact, LineContact):
         raise ValueError(f"contact = {type(contact).__name__} is not valid; valid: a LineContact")
@@ -816,6 +1108,8 @@ def solve_ehl(
             f"solve_ehl computes in {dtype}; EHL needs float64 (pressures ~1e9 Pa against films "
             "~1e-8 m). Enable it with jax.config.update('jax_enable_x64', True) before use"
         )
+    solids = (steel(), steel()) if solids is None else tuple(solids)
+    x_here = _grid_positions(model, contact, lubricant)
     if previous is not None:
         if time_step is None:
             raise ValueError(
@@ -823,24 +1117,42 @@ def solve_ehl(
             )
         check_positive("time_step", time_step, "s")
         inv_dt = 1.0 / jnp.asarray(time_step, dtype=dtype)
-        b = contact.hertz_half_width
-        x_here = _grid_positions(model, contact, lubricant)
         rho_h_prev = jnp.interp(x_here, previous.x, previous.rho_h)
-        del b
     else:
         inv_dt = jnp.zeros((), dtype=dtype)
         rho_h_prev = jnp.zeros((n,), dtype=dtype)
-    inp = _Inputs(contact, lubricant, rho_h_prev, inv_dt, jnp.zeros((n,), dtype=dtype))
+    mixed = "smooth" if surfaces is None else model.mixed
+    sigma = jnp.zeros((), dtype=dtype) if surfaces is None else surfaces.composite_rq
+    if mixed != "deterministic":
+        offset = jnp.zeros((n,), dtype=dtype)
+    else:
+        d = jnp.zeros((2,), dtype=dtype) if displacement is None else jnp.asarray(displacement)
+        offset = -(
+            surfaces.displaced_height(0, x_here, d[0]) + surfaces.displaced_height(1, x_here, d[1])
+        )
+    rise = (
+        jnp.zeros((n,), dtype=dtype)
+        if temperature_rise is None
+        else jnp.broadcast_to(jnp.asarray(temperature_rise, dtype=dtype), (n,))
+    )
+    z = jnp.zeros((n,), dtype=dtype)
+    seed = z
+    if mixed == "statistical" and initial is not None:
+        seed = jnp.interp(x_here, initial.x, initial.asperity_pressure)
+    inp = _Inputs(contact, lubricant, rho_h_prev, inv_dt, offset, rise, seed, sigma)
     if initial is not None:
-        return _solve_jit(model, True, inp, initial.x, initial.p, initial.h0)
+        return _solve_jit(
+            model, True, mixed, inp, initial.x, initial.fluid_pressure, initial.h0, solids
+        )
     z = jnp.zeros((2,), dtype=dtype)
-    return _solve_jit(model, False, inp, z, z, jnp.zeros((), dtype=dtype))
+    return _solve_jit(model, False, mixed, inp, z, z, jnp.zeros((), dtype=dtype), solids)
 
 
 def _grid_positions(model: EHLModel, contact: LineContact, lubricant: Lubricant):
     """Node positions x (m) of ``solve_ehl``'s fine grid for this contact."""
     n = model.n_nodes
-    inp = _Inputs(contact, lubricant, jnp.zeros((n,)), jnp.zeros(()), jnp.zeros((n,)))
+    z = jnp.zeros((n,))
+    inp = _Inputs(contact, lubricant, z, jnp.zeros(()), z, z, z, jnp.zeros(()))
     sc = _scales(model, inp)
     x, _ = _grid(sc, n)
     return x * sc.b

@@ -1,0 +1,215 @@
+"""Transient passage of one contact through a sequence of states (issue 4, paper Eqs. 4-9).
+
+A tooth pair's contact changes along the path of contact: load, radius of curvature and surface
+velocities follow the mesh position, and each surface's roughness moves with its own velocity. The
+passage marches the EHL problem through a given sequence of contact states with ``lax.scan``:
+
+- Reynolds with the squeeze term ∂(ρh)/∂t by backward Euler, ρh of the previous step interpolated
+  onto this step's nodes (the grid follows the Hertz half-width);
+- roughness Sj(x, t) = scale · zj(x − xj0 − dj(t)), dj = ∫ uj dt by the trapezoidal rule;
+- thermal (``model.thermal``): the surface temperatures by the transient moving-heat-source model
+  with memory (paper Eq. 9; :class:`~jaxgear.lubrication.thermal.SubsurfaceTemperature`, carried
+  from step to step with each solid), the film temperature with its time derivative ∂ϕm/∂t;
+- a warm start from the previous step.
+
+The time step is the caller's choice. Tied to the grid, Δt = Δx/ur moves the roughness about one
+cell per step (EHL_NOTES "Transient"); :func:`grid_time_step` gives it. Backward Euler is first
+order in Δt: halving Δt halves the time-discretisation error (tested).
+"""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+
+from .._validation import is_concrete
+from ..material import steel
+from . import thermal as thermal_mod
+from .ehl import (
+    EHLModel,
+    EHLSolution,
+    LineContact,
+    _grid_positions,
+    _Inputs,
+    _solve_impl,
+)
+from .lubricant import Lubricant
+from .roughness import Surfaces
+
+
+def grid_time_step(contact: LineContact, lubricant: Lubricant, model: EHLModel):
+    """Δt = Δx/ur, s: the step that moves the roughness one grid cell at the rolling velocity."""
+    x = _grid_positions(model, contact, lubricant)
+    return (x[1] - x[0]) / contact.rolling_velocity
+
+
+def _advect_to(temperature, x_old, x_new, shift):
+    """T(x_new − shift) interpolated from the (n, nz) field on x_old; 0 for material entering."""
+    return jax.vmap(
+        lambda col: jnp.interp(x_new - shift, x_old, col, left=0.0, right=0.0),
+        in_axes=1,
+        out_axes=1,
+    )(temperature)
+
+
+def _roughness_offset(mixed, surfaces, x, d):
+    if mixed != "deterministic":
+        return jnp.zeros_like(x)
+    return -(surfaces.displaced_height(0, x, d[0]) + surfaces.displaced_height(1, x, d[1]))
+
+
+def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, first):
+    prev, temp1, temp2, d, t_prev, u_prev = carry
+    dt = jnp.maximum(t - t_prev, 1e-300)
+    u_now = jnp.stack([contact.u1, contact.u2])
+    d = d + 0.5 * (u_prev + u_now) * (t - t_prev)
+    x = _grid_positions(model, contact, lubricant)
+    dx = x[1] - x[0]
+    inlet = contact.inlet_temperature
+    if first:
+        rho_h_prev = jnp.zeros_like(x)
+        inv_dt = jnp.zeros(())
+        rise = jnp.zeros_like(x)
+    else:
+        rho_h_prev = jnp.interp(x, prev.x, prev.rho_h)
+        inv_dt = 1.0 / dt
+        rise = jnp.interp(x, prev.x, prev.temperature - inlet, left=0.0, right=0.0)
+    sigma = jnp.zeros(()) if surfaces is None else surfaces.composite_rq
+    if first:
+        seed = jnp.zeros_like(x)
+    else:
+        seed = jnp.interp(x, prev.x, prev.asperity_pressure)
+    inp = _Inputs(
+        contact,
+        lubricant,
+        rho_h_prev,
+        inv_dt,
+        _roughness_offset(mixed, surfaces, x, d),
+        rise,
+        seed,
+        sigma,
+    )
+    transient = None
+    if model.thermal:
+        frees = []
+        for temp, u, solid in ((temp1, contact.u1, solids[0]), (temp2, contact.u2, solids[1])):
+            advected = _advect_to(temp, prev.x, x, u * dt)
+            state = thermal_mod.SubsurfaceTemperature(temperature=advected, depth=depth)
+            frees.append(thermal_mod.transient_predict(state, dx, 0.0, dt, solid))
+        response = tuple((f[:, 0], jnp.full_like(x, g[0])) for f, g in frees)
+        transient = (response, None if first else rise, None if first else dt)
+    if first:
+        sol, temps = _solve_impl(
+            model, False, mixed, inp, x[:2], x[:2], jnp.zeros(()), solids, transient
+        )
+    else:
+        sol, temps = _solve_impl(
+            model, True, mixed, inp, prev.x, prev.fluid_pressure, prev.h0, solids, transient
+        )
+    if model.thermal:
+        temp1 = thermal_mod.transient_update(
+            frees[0][0], frees[0][1], temps.flux1, depth
+        ).temperature
+        temp2 = thermal_mod.transient_update(
+            frees[1][0], frees[1][1], temps.flux2, depth
+        ).temperature
+    return (sol, temp1, temp2, d, t, u_now), sol
+
+
+@eqx.filter_jit
+def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, solids):
+    n = model.n_nodes
+    depth = jnp.asarray(thermal_mod.depth_grid())
+    first_contact = jax.tree_util.tree_map(lambda a: a[0], contacts)
+    zeros_t = jnp.zeros((n, depth.shape[0]))
+    u0 = jnp.stack([first_contact.u1, first_contact.u2])
+    x0 = _grid_positions(model, first_contact, lubricant)
+    # a placeholder "previous" solution for the first step: only its grid is read (for the empty
+    # subsurface fields)
+    dt0 = times[1] - times[0]
+    proto = eqx.filter_eval_shape(
+        lambda: _solve_impl(
+            model,
+            False,
+            mixed,
+            _Inputs(first_contact, lubricant, x0, jnp.zeros(()), x0, x0, x0, jnp.zeros(())),
+            x0[:2],
+            x0[:2],
+            jnp.zeros(()),
+            solids,
+        )[0]
+    )
+    placeholder = jax.tree_util.tree_map(lambda s: jnp.zeros(s.shape, s.dtype), proto)
+    placeholder = eqx.tree_at(lambda s: s.x, placeholder, x0)
+    carry = (placeholder, zeros_t, zeros_t, jnp.asarray(displacement0), times[0] - dt0, u0)
+    carry, sol0 = _step(
+        model, mixed, lubricant, surfaces, solids, depth, carry, first_contact, times[0], True
+    )
+    rest = jax.tree_util.tree_map(lambda a: a[1:], contacts)
+
+    def body(carry, xs):
+        contact, t = xs
+        return _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, False)
+
+    _, sols = jax.lax.scan(body, carry, (rest, times[1:]))
+    return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), sol0, sols)
+
+
+def solve_ehl_passage(
+    contacts: LineContact,
+    lubricant: Lubricant,
+    model: EHLModel | None = None,
+    surfaces: Surfaces | None = None,
+    *,
+    times,
+    displacement=(0.0, 0.0),
+    solids=None,
+) -> EHLSolution:
+    """March one contact through ``K`` states (transient EHL, ``lax.scan``).
+
+    Args:
+        contacts: a LineContact whose fields have a leading axis of length K ≥ 2 (the states at
+            ``times``; e.g. built with ``jax.vmap`` or by passing arrays).
+        lubricant: the Lubricant.
+        model: static EHLModel (``thermal=True`` for the transient temperatures).
+        surfaces: None (smooth) or Surfaces (mixed; roughness moving with each surface).
+        times: (K,) increasing, s. The first state is solved steadily (no squeeze; the surfaces
+            enter at the bulk temperature); each later one is a backward-Euler step from the one
+            before.
+        displacement: (d1, d2) of the surfaces at ``times[0]``, m.
+        solids: (Material, Material) of gears 1 and 2 (default steel).
+
+    Returns:
+        EHLSolution with a leading axis K (per-step ``converged``; the grid of each step is in x).
+    """
+    model = EHLModel() if model is None else model
+    if not isinstance(model, EHLModel):
+        raise ValueError(f"model = {model!r} is not valid; valid: an EHLModel")
+    if not isinstance(contacts, LineContact):
+        raise ValueError(f"contacts = {type(contacts).__name__} is not valid; valid: a LineContact")
+    if surfaces is not None and not isinstance(surfaces, Surfaces):
+        raise ValueError(
+            f"surfaces = {type(surfaces).__name__} is not valid; valid: None or a Surfaces"
+        )
+    times = jnp.asarray(times, dtype=float)
+    k = times.shape[0] if times.ndim == 1 else 0
+    if k < 2:
+        raise ValueError(f"times has shape {times.shape}; valid: (K,) with K ≥ 2 increasing times")
+    contacts = jax.tree_util.tree_map(
+        lambda a: jnp.broadcast_to(jnp.asarray(a, dtype=float), (k,)), contacts
+    )
+    if is_concrete(times) and not bool(jnp.all(jnp.diff(times) > 0)):
+        raise ValueError("times are not increasing; valid: strictly increasing times, s")
+    solids = (steel(), steel()) if solids is None else tuple(solids)
+    mixed = "smooth" if surfaces is None else model.mixed
+    return _passage(
+        model,
+        mixed,
+        contacts,
+        lubricant,
+        surfaces,
+        times,
+        jnp.asarray(displacement, dtype=float),
+        solids,
+    )
