@@ -20,9 +20,19 @@ from .ehl import EHLModel, LineContact, solve_ehl
 LOADED_SHARE = 1e-4
 
 
+def _sequential(fn):
+    """Like ``jax.vmap(fn)`` over the leading axis, but one element after the other."""
+    return lambda *args: jax.lax.map(lambda a: fn(*a), args)
+
+
 def ehl_model_of(fidelity) -> EHLModel:
     """The EHL solver configuration a Fidelity asks for."""
-    return EHLModel(n_nodes=fidelity.n_nodes)
+    return EHLModel(
+        n_nodes=fidelity.n_nodes,
+        thermal=fidelity.thermal,
+        mixed=fidelity.mixed_model,
+        boundary_friction=fidelity.boundary_friction,
+    )
 
 
 def ehl_contact_forces(
@@ -38,12 +48,14 @@ def ehl_contact_forces(
     """
     from ..tribodynamics import ContactForces
 
-    if fidelity.friction == "ehl_mixed" or fidelity.thermal:
+    if fidelity.transient:
         raise ValueError(
-            "Fidelity(friction='ehl_mixed') and thermal=True need the thermal mixed EHL solver, which "
-            "is not part of jaxgear yet; use friction='ehl_smooth', thermal=False"
+            "Fidelity.transient = True is not valid in the coupled model yet; valid: False. The "
+            "transient passage exists per contact (jaxgear.lubrication.passage.solve_ehl_passage) "
+            "but is not wired into the tribo-dynamic fixed point"
         )
     model = ehl_model_of(fidelity)
+    rough = surfaces if fidelity.friction == "ehl_mixed" else None
     width = pair.face_width
     total = mesh.total_load
     loaded = load > LOADED_SHARE * total
@@ -65,16 +77,23 @@ def ehl_contact_forces(
             e_reduced=e_red,
             inlet_temperature=inlet_temperature,
         )
-        return solve_ehl(contact, lubricant, model, initial=init)
+        return solve_ehl(
+            contact, lubricant, model, rough, initial=init, solids=tuple(pair.materials)
+        )
 
     flat = lambda x: jnp.reshape(x, (-1,))
+    # Smooth iso-thermal contacts are batched with vmap. Thermal and mixed solves run an outer
+    # (Picard) iteration of Newton solves with cold-start fallbacks behind lax.cond; under vmap a
+    # cond becomes a select that executes every branch, so those contacts are solved one after the
+    # other (lax.map), where a fallback costs only when it is taken.
+    batch = jax.vmap if (model.thermal is False and rough is None) else _sequential
     if initial is None:
-        sols = jax.vmap(lambda r, wpw, a, b: one(r, wpw, a, b, None))(
+        sols = batch(lambda r, wpw, a, b: one(r, wpw, a, b, None))(
             flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s)
         )
     else:
         init_flat = jax.tree_util.tree_map(lambda x: jnp.reshape(x, (-1, *x.shape[2:])), initial)
-        sols = jax.vmap(one)(flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s), init_flat)
+        sols = batch(one)(flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s), init_flat)
     sols = jax.tree_util.tree_map(lambda x: jnp.reshape(x, (*shape, *x.shape[1:])), sols)
     mask = (loaded & ok_u).astype(load.dtype)
     fs = sols.friction_sliding * width * mask
@@ -84,6 +103,7 @@ def ehl_contact_forces(
         friction_rolling=fr,
         damping=sols.damping * width * mask,
         power_sliding=sols.power_loss_sliding * width * mask,
+        # (the sliding loss includes the asperity (boundary) friction of mixed lubrication)
         power_rolling=sols.power_loss_rolling * width * mask,
         friction_coefficient=jnp.sqrt(fs**2 + fr**2) / jnp.where(loaded, load, 1.0) * mask,
         converged=jnp.all(jnp.where(mask > 0, sols.converged, True)),

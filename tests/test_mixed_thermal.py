@@ -1,0 +1,249 @@
+"""Thermal mixed EHL (issue 4): asperity contact, roughness, temperatures, transient passage.
+
+Contacts are the paper's pitch-point contact (REFERENCE §2-§3) from ``ehl_cases``; roughness the
+synthetic ground (Rq 0.40 µm per surface) and polished (0.05 µm) presets (REFERENCE §6).
+"""
+
+import math
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from ehl_cases import gear_contact
+
+import jaxgear as jg
+from jaxgear.lubrication import asperity
+from jaxgear.lubrication.passage import grid_time_step, solve_ehl_passage
+from jaxgear.lubrication.roughness import Surfaces, ground, polished
+from jaxgear.material import steel
+
+LUB = jg.presets.mil_l_23699()
+# Statistical mixed model: the mean film needs no roughness resolution, 129 nodes suffice.
+STAT = jg.EHLModel(n_nodes=129, mixed="statistical")
+STAT_THERMAL = jg.EHLModel(n_nodes=129, mixed="statistical", thermal=True)
+# Deterministic: the roughness is in the film; 257 nodes give Δx ≈ 3.7 µm at 700 N m, coarse
+# against the 20 µm correlation length but enough to show contact.
+DET = jg.EHLModel(n_nodes=257, mixed="deterministic")
+
+
+def _finite(sol):
+    return all(np.all(np.isfinite(np.asarray(v))) for v in jax.tree_util.tree_leaves(sol))
+
+
+# --------------------------------------------------------------------------------------------------
+# Greenwood-Tripp integrals against closed forms
+# --------------------------------------------------------------------------------------------------
+def test_gt_integrals_match_closed_forms():
+    lam = np.linspace(-2.0, 4.0, 13)
+    tail = np.array([0.5 * math.erfc(v / math.sqrt(2.0)) for v in lam])  # F0 = 1 − Φ(λ)
+    pdf = np.exp(-0.5 * lam**2) / math.sqrt(2.0 * math.pi)
+    # quadrature of smooth integrands: 1e-10 relative is far above its round-off
+    np.testing.assert_allclose(asperity.gt_integral(0.0, lam), tail, rtol=1e-10)
+    np.testing.assert_allclose(asperity.gt_integral(1.0, lam), pdf - lam * tail, rtol=1e-9)
+    # F_n(0) = 2^((n−1)/2) Γ((n+1)/2) / √(2π)
+    for n in (2.0, 2.5):
+        exact = 2 ** ((n - 1) / 2) * math.gamma((n + 1) / 2) / math.sqrt(2 * math.pi)
+        np.testing.assert_allclose(asperity.gt_integral(n, 0.0), exact, rtol=1e-9)
+
+
+# --------------------------------------------------------------------------------------------------
+# Limits: no roughness is the smooth solution
+# --------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "model",
+    [STAT, pytest.param(DET, marks=pytest.mark.slow)],
+    ids=["statistical", "deterministic"],
+)
+def test_roughness_scale_zero_reproduces_smooth(model):
+    c = gear_contact(rpm=2000.0)
+    smooth = jg.solve_ehl(c, LUB, model)
+    rough = jg.solve_ehl(c, LUB, model, ground(scale=1e-4))
+    assert bool(smooth.converged) and bool(rough.converged)
+    # the issue's bound: film and friction within 1 % (Rq = 40 pm changes them by < 1e-3)
+    for name in ("h_central", "h_min", "friction_sliding", "power_loss"):
+        np.testing.assert_allclose(getattr(rough, name), getattr(smooth, name), rtol=1e-2)
+    assert float(rough.contact_load_share) < 1e-3
+
+
+# --------------------------------------------------------------------------------------------------
+# Regimes of REFERENCE §6-§7
+# --------------------------------------------------------------------------------------------------
+def test_deterministic_ground_low_speed_has_asperity_contact():
+    # ground at a quarter of its roughness (the full ground roughness at 500 rpm is deep mixed,
+    # where the deterministic solve reports non-convergence): contact appears, and the asperity
+    # pressures stand well above Hertz (REFERENCE §7 R10: above 3 GPa against ph ≈ 1.2 GPa)
+    c = gear_contact(rpm=500.0)
+    sol = jg.solve_ehl(c, LUB, DET, ground(scale=0.25))
+    assert bool(sol.converged), float(sol.residual)
+    assert float(sol.contact_fraction) > 0.0
+    assert float(sol.p_max) > 2.0 * float(sol.hertz_pressure)
+    assert abs(float(sol.load_error)) < 1e-6
+
+
+def test_statistical_ground_vs_polished_regimes():
+    # REFERENCE §6: λ ≈ 0.1-0.4 ground (deep mixed), 0.8-3.4 polished. R10: polished at speed E is
+    # full film with p well below 2 GPa.
+    slow = jg.solve_ehl(gear_contact(rpm=500.0), LUB, STAT_THERMAL, ground())
+    fast = jg.solve_ehl(gear_contact(rpm=3500.0), LUB, STAT_THERMAL, polished())
+    assert bool(slow.converged) and bool(fast.converged)
+    assert float(slow.contact_load_share) > 0.03  # asperities carry a visible share of the load
+    assert float(fast.contact_load_share) < 0.01  # full film
+    assert float(fast.p_max) < 2.0e9
+    # boundary friction adds to the fluid's: the ground contact has the larger friction coefficient
+    w = float(gear_contact().load_per_width)
+    assert abs(float(slow.friction_sliding)) / w > abs(float(fast.friction_sliding)) / w
+
+
+# --------------------------------------------------------------------------------------------------
+# Thermal
+# --------------------------------------------------------------------------------------------------
+def test_thermal_friction_below_isothermal_at_high_sliding_equal_without():
+    th = jg.EHLModel(n_nodes=129, thermal=True)
+    iso = jg.EHLModel(n_nodes=129)
+    high = gear_contact(rpm=3500.0, slide_to_roll=1.0)
+    hot, cold = jg.solve_ehl(high, LUB, th), jg.solve_ehl(high, LUB, iso)
+    assert bool(hot.converged) and bool(cold.converged)
+    assert float(hot.temperature.max()) > float(high.inlet_temperature) + 1.0
+    assert abs(float(hot.friction_sliding)) < abs(float(cold.friction_sliding))
+    assert float(hot.h_central) < float(cold.h_central)  # thinner film at the hotter viscosity
+    # pure rolling at low speed: only the small Poiseuille heat (< 1 K): friction and film equal
+    # within 1 % (at 3500 rpm the rolling heat alone already thins the film by ~3 %: R9)
+    roll = gear_contact(rpm=500.0, slide_to_roll=0.0)
+    hot0, cold0 = jg.solve_ehl(roll, LUB, th), jg.solve_ehl(roll, LUB, iso)
+    np.testing.assert_allclose(hot0.friction_rolling, cold0.friction_rolling, rtol=1e-2)
+    np.testing.assert_allclose(hot0.h_central, cold0.h_central, rtol=1e-2)
+
+
+def test_temperature_rise_grows_with_speed_and_heat_is_conserved():
+    rises = []
+    for rpm in (1000.0, 3500.0):
+        c = gear_contact(rpm=rpm, slide_to_roll=0.5)
+        sol = jg.solve_ehl(c, LUB, STAT_THERMAL, ground())
+        assert bool(sol.converged)
+        rises.append(float(sol.temperature.max() - c.inlet_temperature))
+        # energy balance of the converged thermal state: the heat generated (paper Eq. 12) leaves
+        # by conduction into both solids and by convection with the film (REFERENCE §5)
+        temps = jg.thermal.solve_contact_temperatures(
+            sol.x,
+            sol.heat_flux,
+            jnp.maximum(sol.h, 0.0),
+            c.u1,
+            c.u2,
+            steel(),
+            steel(),
+            sol.density,
+            LUB.specific_heat,
+            LUB.thermal_conductivity,
+        )
+        generated = float(jnp.sum(sol.heat_flux))
+        removed = float(jnp.sum(temps.flux1 + temps.flux2 + temps.convected))
+        assert abs(removed - generated) <= 1e-9 * abs(generated)
+        # and the solution's surface temperatures are those of its own heat source (Picard
+        # converged: within 1 % of the rise)
+        rise1 = np.asarray(sol.surface_temperature1 - c.inlet_temperature)
+        np.testing.assert_allclose(rise1, temps.surface1, atol=0.01 * rise1.max())
+    assert rises[1] > rises[0] > 0.0
+
+
+# --------------------------------------------------------------------------------------------------
+# Gradients (implicit through each Newton solve, exact through the fixed number of outer steps)
+# --------------------------------------------------------------------------------------------------
+@pytest.mark.slow
+def test_gradients_match_finite_differences():
+    base = gear_contact(rpm=3000.0)
+
+    def loss(scale, load, t_in):
+        c = jg.LineContact(
+            reduced_radius=base.reduced_radius,
+            load_per_width=load,
+            u1=base.u1,
+            u2=base.u2,
+            e_reduced=base.e_reduced,
+            inlet_temperature=t_in,
+        )
+        return jg.solve_ehl(c, LUB, STAT, ground(scale=scale)).power_loss
+
+    x0 = (1.0, float(base.load_per_width), 363.15)
+    steps = (1e-4, 1e-4 * x0[1], 1e-2)
+    grads = jax.jacfwd(loss, argnums=(0, 1, 2))(*x0)
+    for i, (g, d) in enumerate(zip(grads, steps, strict=True)):
+        xp = list(x0)
+        xm = list(x0)
+        xp[i] += d
+        xm[i] -= d
+        fd = (float(loss(*xp)) - float(loss(*xm))) / (2 * d)
+        # smooth map (the statistical asperity pressure is C∞ in the film): central differences
+        # agree to ~1e-4 relative; the outer iteration's residual (2^-12 of the update) bounds it
+        np.testing.assert_allclose(float(g), fd, rtol=2e-3)
+
+
+# --------------------------------------------------------------------------------------------------
+# Extremes: converged or flagged, never NaN
+# --------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "rpm, slide, scale",
+    [(300.0, 0.3, 3.0), (3500.0, 2.0, 1.0), (15000.0, 0.1, 0.1)],
+    ids=["lambda-to-zero", "pure-sliding", "thick-film"],
+)
+def test_extremes_are_finite(rpm, slide, scale):
+    sol = jg.solve_ehl(gear_contact(rpm=rpm, slide_to_roll=slide), LUB, STAT_THERMAL, ground(scale))
+    assert _finite(sol)
+    assert bool(sol.converged) or float(sol.residual) > 0.0
+
+
+# --------------------------------------------------------------------------------------------------
+# Transient passage
+# --------------------------------------------------------------------------------------------------
+def _bump_surfaces(b, amplitude=50e-9, width=10e-6, start=-2.5):
+    dx, n = 0.5e-6, 8192
+    xs = np.arange(n) * dx
+    z1 = amplitude * np.exp(-(((xs - (n * dx + start * b)) / width) ** 2))
+    return Surfaces(profile1=jnp.asarray(z1), profile2=jnp.zeros(n), dx=dx)
+
+
+def _passage(model, contact, surf, dt, k):
+    contacts = jax.tree_util.tree_map(lambda a: jnp.full((k,), a), contact)
+    return solve_ehl_passage(contacts, LUB, model, surf, times=jnp.arange(k) * dt)
+
+
+@pytest.mark.slow
+def test_passage_single_asperity_travels_with_its_surface():
+    # pure rolling: the bump (on surface 1, entering from x = −2.5 b) is carried at u1; the
+    # pressure disturbance it causes moves with it
+    model = jg.EHLModel(n_nodes=129, mixed="deterministic")
+    c = gear_contact(rpm=2000.0, slide_to_roll=0.0)
+    b = float(c.hertz_half_width)
+    dt = float(grid_time_step(c, LUB, model))
+    k = 48
+    sols = _passage(model, c, _bump_surfaces(b), dt, k)
+    smooth = jg.solve_ehl(c, LUB, model)
+    assert bool(jnp.all(sols.converged))
+    assert _finite(sols)
+    u1 = float(c.u1)
+    dx = float(sols.x[0, 1] - sols.x[0, 0])
+    for i in (16, 24, 32):
+        dp = np.asarray(sols.p[i] - smooth.p)
+        x_peak = float(sols.x[i][np.argmax(np.abs(dp))])
+        expected = -2.5 * b + u1 * i * dt
+        # within the bump's half-width plus two cells of the disturbance's own shape
+        assert abs(x_peak - expected) < 10e-6 + 2 * dx, (i, x_peak, expected)
+
+
+@pytest.mark.slow
+def test_passage_time_step_convergence_is_first_order():
+    model = jg.EHLModel(n_nodes=129, mixed="deterministic")
+    c = gear_contact(rpm=2000.0, slide_to_roll=0.3)
+    b = float(c.hertz_half_width)
+    dt = float(grid_time_step(c, LUB, model))
+    surf = _bump_surfaces(b)
+    t_end = 24 * dt
+    results = []
+    for refine in (1, 2, 4):
+        sols = _passage(model, c, surf, dt / refine, 24 * refine + 1)
+        results.append(np.asarray(sols.h_central[-1]))
+        assert float(jnp.abs(sols.x[-1, 0])) > 0 and abs(24 * refine * dt / refine - t_end) < 1e-15
+    e1 = abs(results[0] - results[2])
+    e2 = abs(results[1] - results[2])
+    # backward Euler: halving Δt halves the error (observed ratio within 1.4-3)
+    assert 1.4 < e1 / e2 < 3.0, (e1, e2)
