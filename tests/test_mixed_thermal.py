@@ -222,12 +222,18 @@ def test_passage_single_asperity_travels_with_its_surface():
     assert _finite(sols)
     u1 = float(c.u1)
     dx = float(sols.x[0, 1] - sols.x[0, 0])
-    for i in (16, 24, 32):
-        dp = np.asarray(sols.p[i] - smooth.p)
-        x_peak = float(sols.x[i][np.argmax(np.abs(dp))])
+    for i in (8, 16, 24, 32, 40):
+        # the film dip is where the bump is (the pressure disturbance of an inlet bump is not
+        # local: the inlet flow changes the whole pressure field)
+        dh = np.asarray(sols.h[i] - smooth.h)
+        x_dip = float(sols.x[i][np.argmin(dh)])
         expected = -2.5 * b + u1 * i * dt
-        # within the bump's half-width plus two cells of the disturbance's own shape
-        assert abs(x_peak - expected) < 10e-6 + 2 * dx, (i, x_peak, expected)
+        # within the bump's half-width plus one cell
+        assert abs(x_dip - expected) < 10e-6 + dx, (i, x_dip, expected)
+        if expected < -1.2 * b:
+            # in the inlet the film dip is the bump itself (little pressure there to flatten it);
+            # inside the Hertz zone the bump is flattened to a few nm, as micro-EHL predicts
+            assert dh.min() < -0.5 * 50e-9
 
 
 @pytest.mark.slow
@@ -237,13 +243,14 @@ def test_passage_time_step_convergence_is_first_order():
     b = float(c.hertz_half_width)
     dt = float(grid_time_step(c, LUB, model))
     surf = _bump_surfaces(b)
-    t_end = 24 * dt
-    results = []
+    # 48 base steps carry the bump from −2.5 b to about the Hertz centre
+    fields = []
     for refine in (1, 2, 4):
-        sols = _passage(model, c, surf, dt / refine, 24 * refine + 1)
-        results.append(np.asarray(sols.h_central[-1]))
-        assert float(jnp.abs(sols.x[-1, 0])) > 0 and abs(24 * refine * dt / refine - t_end) < 1e-15
-    e1 = abs(results[0] - results[2])
-    e2 = abs(results[1] - results[2])
-    # backward Euler: halving Δt halves the error (observed ratio within 1.4-3)
-    assert 1.4 < e1 / e2 < 3.0, (e1, e2)
+        sols = _passage(model, c, surf, dt / refine, 48 * refine + 1)
+        assert bool(jnp.all(sols.converged))
+        fields.append(np.asarray(sols.h[-1]))
+    e1 = np.max(np.abs(fields[0] - fields[2]))
+    e2 = np.max(np.abs(fields[1] - fields[2]))
+    # backward Euler, first order: against the Δt/4 solution, (1 − 1/4)/(1/2 − 1/4) = 3
+    # (second order would give 5); the band allows for the pre-asymptotic range
+    assert 2.2 < e1 / e2 < 4.0, (e1, e2)
