@@ -29,7 +29,9 @@ def _as_array(value: Any) -> np.ndarray | None:
 def _fmt(value: np.ndarray) -> str:
     if value.ndim == 0:
         return f"{float(value):.6g}"
-    return np.array2string(value, precision=6, threshold=8)
+    # One line, whatever the rank: the CLI prints the message as a single line.
+    text = np.array2string(value.ravel(), precision=6, threshold=8, max_line_width=10**9)
+    return text if value.ndim == 1 else f"{text} (shape {value.shape})"
 
 
 def check_finite(name: str, value: Any) -> None:
@@ -57,16 +59,18 @@ def check_range(
     arr = _as_array(value)
     if arr is None:
         return
-    check_finite(name, arr)
+    # An infinite bound is never part of the range (only finite values pass).
+    lb = "[" if low_inclusive and math.isfinite(low) else "("
+    hb = "]" if high_inclusive and math.isfinite(high) else ")"
+    u = f" {unit}" if unit else ""
+    valid = f"valid range: {lb}{low:g}, {high:g}{hb}{u}"
+    if not np.all(np.isfinite(arr)):
+        # Name the real range, not just "finite": the user needs to know what to put instead.
+        raise ValueError(f"{name} = {_fmt(arr)} is not finite; {valid}")
     ok_low = arr >= low if low_inclusive else arr > low
     ok_high = arr <= high if high_inclusive else arr < high
     if not np.all(ok_low & ok_high):
-        lb = "[" if low_inclusive else "("
-        hb = "]" if high_inclusive else ")"
-        u = f" {unit}" if unit else ""
-        raise ValueError(
-            f"{name} = {_fmt(arr)}{u} is out of range; valid range: {lb}{low:g}, {high:g}{hb}{u}"
-        )
+        raise ValueError(f"{name} = {_fmt(arr)}{u} is out of range; {valid}")
 
 
 def check_positive(name: str, value: Any, unit: str = "") -> None:
@@ -77,6 +81,29 @@ def check_positive(name: str, value: Any, unit: str = "") -> None:
 def check_non_negative(name: str, value: Any, unit: str = "") -> None:
     """Raise unless every element is finite and ≥ 0."""
     check_range(name, value, 0.0, math.inf, unit=unit)
+
+
+def check_instance(name: str, value: Any, cls: type, what: str | None = None) -> None:
+    """Raise unless ``value`` is an instance of ``cls`` (a wrong type would fail later, obscurely)."""
+    if not isinstance(value, cls):
+        what = what or f"a jaxgear.{cls.__name__}"
+        raise ValueError(f"{name} = {_short_repr(value)} is not valid; valid: {what}")
+
+
+def check_integer(name: str, value: Any, low: int, high: int | None = None) -> None:
+    """Raise unless ``value`` is a Python/NumPy integer (not bool) in [low, high]."""
+    ok = isinstance(value, int | np.integer) and not isinstance(value, bool)
+    ok = ok and value >= low and (high is None or value <= high)
+    if not ok:
+        top = "inf)" if high is None else f"{high}]"
+        raise ValueError(
+            f"{name} = {value!r} is out of range; valid range: integer in [{low}, {top}"
+        )
+
+
+def _short_repr(value: Any) -> str:
+    text = repr(value) if isinstance(value, str | int | float | bool | None) else None
+    return text if text is not None else f"<{type(value).__name__}>"
 
 
 def check_choice(name: str, value: Any, choices: tuple) -> None:

@@ -15,8 +15,16 @@ import sys
 COMMANDS = ("run", "mesh", "ehl", "optimise")
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors (a bad number, an unknown choice) as one line on stderr and exit code 2, like
+    every other invalid input: argparse's default prints the whole usage block first."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="jaxgear",
         description=(
             "Differentiable thermal tribo-dynamic power loss model of spur gear pairs "

@@ -89,6 +89,7 @@ class Fidelity(eqx.Module):
         _int_at_least("Fidelity.n_nodes", self.n_nodes, 33)
         _int_at_least("Fidelity.steps_per_period", self.steps_per_period, 16)
         _int_at_least("Fidelity.max_fixed_point_iterations", self.max_fixed_point_iterations, 1)
+        _int_at_least("Fidelity.anderson_memory", self.anderson_memory, 0)
         _float_in("Fidelity.constant_mu", self.constant_mu, 0.0, 1.0)
         _float_in("Fidelity.boundary_friction", self.boundary_friction, 0.0, 1.0)
         _float_in("Fidelity.fixed_point_tolerance", self.fixed_point_tolerance, 1e-14, 0.1)
@@ -96,14 +97,13 @@ class Fidelity(eqx.Module):
 
     def replace(self, **changes) -> Fidelity:
         """A copy with some fields changed (validated), e.g. ``fid.replace(dynamics="quasi_static")``."""
-        unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
-        if unknown:
-            raise ValueError(f"unknown Fidelity field(s): {', '.join(sorted(unknown))}")
+        _check_fields(changes)
         return dataclasses.replace(self, **changes)
 
     @classmethod
     def fast(cls, **changes) -> Fidelity:
         """The CLI default: tribo-dynamic, regression-formula friction, 32 positions per cycle."""
+        _check_fields(changes)
         return cls(**changes)
 
     @classmethod
@@ -126,6 +126,7 @@ class Fidelity(eqx.Module):
             n_positions=32,
             n_nodes=257,
         )
+        _check_fields(changes)
         base.update(changes)
         return cls(**base)
 
@@ -142,6 +143,16 @@ class Fidelity(eqx.Module):
     @property
     def uses_ehl(self) -> bool:
         return self.friction in ("ehl_smooth", "ehl_mixed")
+
+
+def _check_fields(changes):
+    fields = [f.name for f in dataclasses.fields(Fidelity)]
+    unknown = set(changes) - set(fields)
+    if unknown:
+        raise ValueError(
+            f"unknown Fidelity field(s): {', '.join(sorted(unknown))}; valid fields: "
+            f"{', '.join(fields)}"
+        )
 
 
 def _choice(name, value, choices):

@@ -9,8 +9,17 @@ from jaxtyping import Array, Float
 from ._validation import check_positive, check_range
 
 
-def _as_float(value):
-    return jnp.asarray(value, dtype=jnp.result_type(float))
+def _as_float(name):
+    def convert(value):
+        try:
+            return jnp.asarray(value, dtype=jnp.result_type(float))
+        except (TypeError, ValueError):
+            # e.g. a string from a config file: name the field instead of numpy's bare message
+            raise ValueError(
+                f"OperatingPoint.{name} = {value!r} is not valid; valid range: a real number"
+            ) from None
+
+    return convert
 
 
 class OperatingPoint(eqx.Module):
@@ -22,9 +31,11 @@ class OperatingPoint(eqx.Module):
         inlet_temperature: oil inlet temperature, K, in [200, 600] K.
     """
 
-    torque: Float[Array, ""] = eqx.field(converter=_as_float)
-    speed_rpm: Float[Array, ""] = eqx.field(converter=_as_float)
-    inlet_temperature: Float[Array, ""] = eqx.field(converter=_as_float, default=363.15)
+    torque: Float[Array, ""] = eqx.field(converter=_as_float("torque"))
+    speed_rpm: Float[Array, ""] = eqx.field(converter=_as_float("speed_rpm"))
+    inlet_temperature: Float[Array, ""] = eqx.field(
+        converter=_as_float("inlet_temperature"), default=363.15
+    )
 
     def __check_init__(self):
         check_positive("OperatingPoint.torque", self.torque, "N m")

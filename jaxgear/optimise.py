@@ -44,7 +44,7 @@ from .fidelity import Fidelity
 from .gear.geometry import gear_geometry
 from .gear.pair import RELIEF_SHAPES, GearPair, TipRelief
 from .operating import OperatingPoint
-from .tribodynamics import simulate_with_state
+from .tribodynamics import check_inputs, simulate_with_state
 
 # Status codes of an optimisation.
 STATUS_CONVERGED = 0  # projected gradient below tolerance
@@ -202,7 +202,7 @@ def _check_bounds(names, lower, upper, units):
     for name, lo, hi, unit in zip(names, lower, upper, units):
         if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
             raise ValueError(
-                f"bounds of {name} = ({lo:g}, {hi:g}) {unit} are invalid; need finite lower < upper"
+                f"bounds of {name} = ({lo:g}, {hi:g}) {unit} are invalid; valid: finite lower < upper"
             )
 
 
@@ -251,7 +251,7 @@ def optimise(
             f"{upper.size} and {len(names)}"
         )
     if not np.all(np.isfinite(x0)):
-        raise ValueError(f"x0 = {x0} is not finite")
+        raise ValueError(f"x0 = {x0} is not finite; valid range: finite values inside the bounds")
     _check_bounds(names, lower, upper, [""] * n)
     width = upper - lower
     x0 = np.clip(x0, lower, upper)
@@ -426,12 +426,9 @@ def _speeds(speeds_rpm, op):
     return jnp.asarray(arr)
 
 
-def _common_checks(op, fidelity):
+def _common_checks(pair, lubricant, surfaces, op, fidelity):
     fidelity = Fidelity.fast() if fidelity is None else fidelity
-    if not isinstance(fidelity, Fidelity):
-        raise ValueError(f"fidelity must be a jaxgear.Fidelity; got {type(fidelity).__name__}")
-    if not isinstance(op, OperatingPoint):
-        raise ValueError(f"op must be a jaxgear.OperatingPoint; got {type(op).__name__}")
+    check_inputs(pair, lubricant, surfaces, op, fidelity)
     return fidelity
 
 
@@ -523,9 +520,7 @@ def optimise_tip_relief(
         (rad) per gear; objective = mean efficiency; parameter names ``tip_relief_amount`` and
         ``tip_relief_start_roll_angle`` (suffixed _1/_2 per gear).
     """
-    fidelity = _common_checks(op, fidelity)
-    if not isinstance(pair, GearPair):
-        raise ValueError(f"pair must be a jaxgear.GearPair; got {type(pair).__name__}")
+    fidelity = _common_checks(pair, lubricant, surfaces, op, fidelity)
     _check_steps(steps)
     if shape == "both":
         results = [
@@ -625,7 +620,7 @@ def optimise_torque(
     trade, though often at a bound. Default bounds: (0.5, 2) × op.torque. Starts at op.torque.
     Returns an OptimisationResult whose ``op`` carries the optimum torque (name "torque").
     """
-    fidelity = _common_checks(op, fidelity)
+    fidelity = _common_checks(pair, lubricant, surfaces, op, fidelity)
     _check_steps(steps)
     t0 = float(op.torque)
     lo, hi = _scalar_bounds("torque", bounds if bounds is not None else (0.5 * t0, 2 * t0), "N m")
@@ -667,7 +662,7 @@ def optimise_roughness_scale(
     Default bounds (0.1, 3). Returns an OptimisationResult whose ``surfaces`` carries the optimum scale
     (name "roughness_scale").
     """
-    fidelity = _common_checks(op, fidelity)
+    fidelity = _common_checks(pair, lubricant, surfaces, op, fidelity)
     _check_steps(steps)
     lo, hi = _scalar_bounds("roughness_scale", bounds, "")
     objective = RoughnessScaleObjective(

@@ -20,10 +20,17 @@ from .fidelity import Fidelity
 from .operating import OperatingPoint
 from .sweep_engine import STATUS_NAMES as POINT_STATUS_NAMES
 from .sweep_engine import run_continuation, run_points
-from .tribodynamics import STATUS_NAMES, simulate_with_state
+from .tribodynamics import STATUS_NAMES, check_inputs, simulate_with_state
 
 #: Inputs a sweep may vary, besides the speed.
-SWEEPABLE = ("speed_rpm", "torque", "inlet_temperature", "roughness_scale", "tip_relief_amount")
+SWEEPABLE = (
+    "speed_rpm",
+    "torque",
+    "inlet_temperature",
+    "roughness_scale",
+    "tip_relief_amount",
+    "backlash",
+)
 
 _SCALARS = (
     "power_loss",
@@ -77,6 +84,8 @@ class SweepResult(eqx.Module):
                 cols["inlet_temperature_C"] = np.asarray(v) - 273.15
             elif k == "tip_relief_amount":
                 cols["tip_relief_um"] = np.asarray(v) * 1e6
+            elif k == "backlash":
+                cols["backlash_um"] = np.asarray(v) * 1e6
             else:
                 cols[k] = np.asarray(v)
         cols.update(
@@ -109,6 +118,8 @@ def _apply(pair, surfaces, op, point):
     if "tip_relief_amount" in point:
         amount = jnp.stack([point["tip_relief_amount"], point["tip_relief_amount"]])
         pair = eqx.tree_at(lambda p: p.tip_relief.amount, pair, amount)
+    if "backlash" in point:
+        pair = eqx.tree_at(lambda p: p.backlash, pair, jnp.asarray(point["backlash"]))
     return pair, surfaces, op
 
 
@@ -148,33 +159,53 @@ def sweep(
         progress: progress bar on stderr.
         devices: devices to shard parallel chunks over (default all local devices).
         **vary: other inputs per point, from ``SWEEPABLE``: torque (N m), inlet_temperature (K),
-            roughness_scale, tip_relief_amount (m, both gears); arrays of length N or scalars.
+            roughness_scale, tip_relief_amount (m, both gears), backlash (m, total clearance 2ℓ
+            along the line of action: small values bring back-side impacts); arrays of length N or
+            scalars.
 
     Returns:
         SweepResult with per-point status; every good point is kept when others fail.
     """
     fidelity = Fidelity.fast() if fidelity is None else fidelity
+    check_inputs(pair, lubricant, surfaces, op, fidelity)
     if mode not in ("parallel", "continuation"):
         raise ValueError(f"mode = {mode!r} is not valid; valid choices: 'parallel', 'continuation'")
+    if chunk_size is not None and (
+        isinstance(chunk_size, bool)
+        or not isinstance(chunk_size, int | np.integer)
+        or chunk_size < 1
+    ):
+        raise ValueError(
+            f"chunk_size = {chunk_size!r} is out of range; valid range: integer >= 1 (or None)"
+        )
     unknown = set(vary) - set(SWEEPABLE)
     if unknown:
         raise ValueError(
-            f"cannot sweep {sorted(unknown)}; sweepable inputs: {', '.join(SWEEPABLE)}"
+            f"cannot sweep {sorted(unknown)}; valid (sweepable) inputs: {', '.join(SWEEPABLE)}"
         )
     if speeds_rpm is not None:
         vary = {"speed_rpm": speeds_rpm, **vary}  # speed first: the CSV's leading column
     if not vary:
         raise ValueError("nothing to sweep: give speeds_rpm or another input from SWEEPABLE")
-    n = max(np.size(v) for v in vary.values())
-    inputs = {}
+    arrays = {}
     for k, v in vary.items():
-        arr = np.asarray(v, dtype=float).reshape(-1)
+        name = "speeds_rpm" if k == "speed_rpm" else k  # the argument's name
+        try:
+            arr = np.asarray(v, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} = {v!r} is not valid; valid: real numbers") from None
+        if arr.ndim > 1 or arr.size == 0:
+            raise ValueError(
+                f"{name} has shape {arr.shape}; valid: a scalar or a non-empty 1-D array of points"
+            )
+        arrays[k] = arr.reshape(-1)
+    n = max(arr.size for arr in arrays.values())
+    inputs = {}
+    for k, arr in arrays.items():
         if arr.size == 1:
             arr = np.full(n, arr[0])
         if arr.size != n:
             raise ValueError(f"{k} has {arr.size} points; expected 1 or {n}")
-        if not np.all(np.isfinite(arr)):
-            raise ValueError(f"{k} contains non-finite values; valid range: finite numbers")
         inputs[k] = arr
     _validate_points(pair, surfaces, op, inputs)
 
@@ -233,6 +264,7 @@ def sweep(
 def _validate_points(pair, surfaces, op, inputs):
     """Every point must be a valid operating point: check them all before any work starts."""
     from ._validation import check_non_negative, check_positive, check_range
+    from .gear.pair import MAX_RELIEF_PER_MODULE
 
     if "speed_rpm" in inputs:
         check_positive("speeds_rpm", inputs["speed_rpm"], "rpm")
@@ -243,7 +275,10 @@ def _validate_points(pair, surfaces, op, inputs):
     if "roughness_scale" in inputs:
         check_non_negative("roughness_scale", inputs["roughness_scale"])
     if "tip_relief_amount" in inputs:
-        check_non_negative("tip_relief_amount", inputs["tip_relief_amount"], "m")
+        top = MAX_RELIEF_PER_MODULE * float(pair.module)
+        check_range("tip_relief_amount", inputs["tip_relief_amount"], 0.0, top, unit="m")
+    if "backlash" in inputs:
+        check_non_negative("backlash", inputs["backlash"], "m")
 
 
 __all__ = ["SWEEPABLE", "SweepResult", "sweep", "POINT_STATUS_NAMES"]

@@ -21,7 +21,7 @@ import lineax as lx
 import optimistix as optx
 from jaxtyping import Array, Bool, Float, Int
 
-from ._validation import check_non_negative, is_concrete
+from ._validation import check_instance, check_non_negative, is_concrete
 from .anderson import Anderson
 from .dynamics.model import DynamicsOptions, MeshInterface
 from .dynamics.response import dte_harmonic_amplitudes, dynamic_response
@@ -30,6 +30,8 @@ from .gear.geometry import gear_geometry
 from .gear.mesh import MeshCycle, mesh_cycle
 from .gear.pair import GearPair
 from .lubrication.friction_models import XuFriction
+from .lubrication.lubricant import Lubricant
+from .lubrication.roughness import Surfaces
 from .material import reduced_modulus
 from .operating import OperatingPoint
 from .power_loss import cycle_mean, efficiency, total_per_position
@@ -457,11 +459,26 @@ def simulate(
         every traced input (forward mode, ``jax.jvp``/``jax.jacfwd``).
     """
     fidelity = Fidelity.fast() if fidelity is None else fidelity
-    if not isinstance(fidelity, Fidelity):
-        raise ValueError(f"fidelity must be a jaxgear.Fidelity; got {type(fidelity).__name__}")
-    if not isinstance(op, OperatingPoint):
-        raise ValueError(f"op must be a jaxgear.OperatingPoint; got {type(op).__name__}")
+    check_inputs(pair, lubricant, surfaces, op, fidelity)
     if is_concrete(surfaces):
         check_non_negative("surfaces.composite_rq", surfaces.composite_rq, "m")
     gear_geometry(pair)  # shapes and geometry checks happen at construction; nothing to redo
     return _simulate(pair, lubricant, surfaces, op, fidelity)
+
+
+def check_inputs(pair, lubricant, surfaces, op, fidelity) -> None:
+    """Types of ``simulate``'s (and ``sweep``'s) arguments: a wrong one would fail deep inside the
+    trace with an AttributeError naming no argument."""
+    check_instance("fidelity", fidelity, Fidelity)
+    check_instance("op", op, OperatingPoint)
+    check_instance("pair", pair, GearPair)
+    check_instance("lubricant", lubricant, Lubricant)
+    check_instance(
+        "surfaces", surfaces, Surfaces, "a jaxgear.Surfaces (jg.presets.smooth() for none)"
+    )
+    for name in ("torque", "speed_rpm", "inlet_temperature"):
+        shape = jnp.shape(getattr(op, name))
+        if shape != ():
+            raise ValueError(
+                f"op.{name} has shape {shape}; valid: a scalar (use jg.sweep for many points)"
+            )

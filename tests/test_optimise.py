@@ -244,7 +244,7 @@ def test_non_converged_points_are_never_used():
         (dict(learning_rate=0.0), "learning_rate"),
         (dict(shape="cubic"), "shape = 'cubic'"),
         (dict(speeds_rpm=[1000.0, -5.0]), "speeds_rpm"),
-        (dict(fidelity="fast"), "fidelity must be"),
+        (dict(fidelity="fast"), "fidelity = 'fast' is not valid"),
     ],
 )
 def test_bad_input_names_the_field(kwargs, needle):

@@ -12,6 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from jaxgear import sweep_engine
 from jaxgear.sweep_engine import (
     FAILED,
     NON_FINITE,
@@ -113,6 +114,82 @@ def test_continuation_carries_state_and_resumes(tmp_path):
         step, jnp.asarray(0.0), {"x": xs}, chunk_size=4, checkpoint_dir=tmp_path, converged_key=None
     )
     np.testing.assert_allclose(again.outputs["cum"], np.cumsum(xs))
+
+
+def _interrupt_after(monkeypatch, points_done):
+    """Ctrl-C between chunks, once ``points_done`` points have finished (the progress update runs
+    after a chunk is stored, so this is an interruption at the worst moment that loses nothing)."""
+
+    def update(self, done, note=""):
+        if done >= points_done:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep_engine._Progress, "update", update)
+
+
+def test_interrupted_sweep_keeps_finished_chunks(tmp_path, monkeypatch):
+    xs = np.arange(10.0)
+    with monkeypatch.context() as patch:
+        _interrupt_after(patch, 6)
+        with pytest.raises(KeyboardInterrupt):
+            run_points(
+                lambda p: {"y": p["x"] + 1.0},
+                {"x": xs},
+                chunk_size=3,
+                checkpoint_dir=tmp_path,
+                converged_key=None,
+            )
+    assert sorted(p.name for p in tmp_path.glob("chunk_*.npz")) == [
+        "chunk_00000.npz",
+        "chunk_00001.npz",
+    ]
+    # The rerun (a different function shows what was recomputed) keeps the 6 finished points and
+    # computes only the rest.
+    again = run_points(
+        lambda p: {"y": p["x"] + 1000.0},
+        {"x": xs},
+        chunk_size=3,
+        checkpoint_dir=tmp_path,
+        converged_key=None,
+    )
+    np.testing.assert_array_equal(again.outputs["y"], np.where(xs < 6, xs + 1.0, xs + 1000.0))
+    np.testing.assert_array_equal(again.status, OK)
+
+
+def test_continuation_failing_chunk_keeps_earlier_points_and_resumes(tmp_path):
+    def step(carry, inp):
+        new = eqx.error_if(carry + inp["x"], inp["x"] == 7.0, "point 7 fails")
+        return new, {"cum": new}
+
+    xs = np.arange(1.0, 11.0)
+    res = run_continuation(
+        step, jnp.asarray(0.0), {"x": xs}, chunk_size=3, checkpoint_dir=tmp_path, converged_key=None
+    )
+    # Points 1-6 (two chunks) finished and are kept; the chunk holding point 7 raised, and the
+    # march stops there: the rest is marked FAILED rather than started from a wrong carry.
+    np.testing.assert_allclose(res.outputs["cum"][:6], np.cumsum(xs)[:6])
+    np.testing.assert_array_equal(res.status, [OK] * 6 + [FAILED] * 4)
+    assert np.all(np.isnan(res.outputs["cum"][6:]))
+    assert len(res.messages) == 1 and "point 7 fails" in res.messages[0]
+
+    # Fixed, the rerun loads the two finished chunks and resumes from the carry stored with the
+    # second: a step that adds 1000 more shows which points were recomputed, and from what state.
+    def fixed(carry, inp):
+        new = carry + inp["x"] + 1000.0
+        return new, {"cum": new}
+
+    again = run_continuation(
+        fixed,
+        jnp.asarray(0.0),
+        {"x": xs},
+        chunk_size=3,
+        checkpoint_dir=tmp_path,
+        converged_key=None,
+    )
+    expected = np.cumsum(xs)
+    expected[6:] = expected[5] + np.cumsum(xs[6:] + 1000.0)
+    np.testing.assert_allclose(again.outputs["cum"], expected)
+    np.testing.assert_array_equal(again.status, OK)
 
 
 def test_sharded_over_two_host_devices_equals_single_device(tmp_path):

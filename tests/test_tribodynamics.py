@@ -171,7 +171,9 @@ def test_bad_input(setup):
         Fidelity(n_positions=8)
     with pytest.raises(ValueError, match="unknown Fidelity field"):
         Fidelity().replace(speed=3)
-    with pytest.raises(ValueError, match="fidelity must be"):
+    with pytest.raises(
+        ValueError, match="fidelity = .fast. is not valid; valid: a jaxgear.Fidelity"
+    ):
         simulate(pair, lub, surf, op, fidelity="fast")
     with pytest.raises(ValueError, match=r"OperatingPoint.speed_rpm = -5"):
         jg.OperatingPoint(torque=700.0, speed_rpm=-5.0)

@@ -31,6 +31,24 @@ CONTACT_FIELDS = (
     ("inlet_temperature", "K"),
 )
 MODEL_FIELDS = ("n_nodes", "viscosity", "compressibility", "shear", "deformation")
+#: [model] keys a config may set (EHLModel's fields) and their TOML types.
+MODEL_KEYS = {
+    "n_nodes": int,
+    "x_in": float,
+    "x_out": float,
+    "auto_domain": bool,
+    "viscosity": str,
+    "compressibility": str,
+    "shear": str,
+    "fb_smoothing": float,
+    "tolerance": float,
+    "max_iterations": int,
+    "coarsest_nodes": int,
+    "continuation_steps": int,
+    "warm_iterations": int,
+    "deformation": str,
+    "wedge_order": int,
+}
 SCALARS = (
     "h_min",
     "h_central",
@@ -86,12 +104,22 @@ def register(subparsers) -> None:
 
 
 def _load_config(path: str | None) -> dict:
+    """The TOML file, its tables and keys checked (a missing file, a typo or a wrong type is a
+    ValueError naming it, so the command exits 2 with one line instead of a traceback)."""
     if path is None:
         return {}
-    import tomllib
+    from jaxgear.config import check_keys, check_top_level, load_toml
 
-    with open(path, "rb") as f:
-        return tomllib.load(f)
+    cfg = load_toml(path)
+    check_top_level(cfg, ("lubricant", "contact", "model"))
+    if not isinstance(cfg.get("lubricant", ""), str):
+        raise ValueError(f"lubricant = {cfg['lubricant']!r} has the wrong type; expected str")
+    for table in ("contact", "model"):
+        if not isinstance(cfg.get(table, {}), dict):
+            raise ValueError(f"{table} = {cfg[table]!r} must be a table [{table}]")
+    check_keys(cfg.get("contact", {}), {name: float for name, _ in CONTACT_FIELDS}, "contact")
+    check_keys(cfg.get("model", {}), MODEL_KEYS, "model")
+    return cfg
 
 
 def run(args: argparse.Namespace) -> int:

@@ -11,10 +11,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from pathlib import Path
 
 import numpy as np
+
+#: Most speeds one run takes (the paper's sweep has 149).
+MAX_SPEEDS = 100_000
 
 
 def _speeds(text: str) -> np.ndarray:
@@ -24,8 +28,19 @@ def _speeds(text: str) -> np.ndarray:
         raise ValueError(
             f"--speeds = {text!r} must be START:STOP:STEP in rpm, e.g. 500:4200:25"
         ) from None
-    if not (start > 0 and stop >= start and step > 0):
-        raise ValueError(f"--speeds = {text!r}: need 0 < START <= STOP and STEP > 0 (rpm)")
+    if not all(map(math.isfinite, (start, stop, step))) or not (
+        start > 0 and stop >= start and step > 0
+    ):
+        raise ValueError(
+            f"--speeds = {text!r} is out of range; valid range: finite 0 < START <= STOP, STEP > 0 "
+            "(rpm)"
+        )
+    # Count before allocating: 1:1e9:1 would otherwise fill the memory before any check.
+    count = math.floor((stop - start) / step + 0.5) + 1
+    if count > MAX_SPEEDS:
+        raise ValueError(
+            f"--speeds = {text!r} gives {count} speeds; valid range: at most {MAX_SPEEDS} speeds"
+        )
     return np.arange(start, stop + 0.5 * step, step)
 
 

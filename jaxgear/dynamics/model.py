@@ -50,7 +50,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from .._validation import check_non_negative, check_positive
+from .._validation import check_finite, check_integer, check_non_negative, check_positive
 
 BacklashKind = Literal["exact", "smooth"]
 BACKLASH_KINDS = ("exact", "smooth")
@@ -82,10 +82,14 @@ class MeshInterface(eqx.Module):
         for name in ("damping", "friction_1", "friction_2"):
             shape = getattr(self, name).shape
             if len(shape) != 2 or shape[1] != 2:
-                raise ValueError(f"MeshInterface.{name} must have shape [M, 2]; got {shape}")
+                raise ValueError(
+                    f"MeshInterface.{name} has shape {shape}; valid: shape [M, 2] (positions, pairs)"
+                )
         if not self.damping.shape == self.friction_1.shape == self.friction_2.shape:
             raise ValueError("MeshInterface tables must share one shape [M, 2]")
         check_non_negative("MeshInterface.damping", self.damping, "N s/m")
+        check_finite("MeshInterface.friction_1", self.friction_1)
+        check_finite("MeshInterface.friction_2", self.friction_2)
 
     @classmethod
     def zeros(cls, n_positions: int) -> MeshInterface:
@@ -146,16 +150,18 @@ class DynamicsOptions(eqx.Module):
             )
         check_positive("DynamicsOptions.backlash_width", self.backlash_width, "m")
         check_positive("DynamicsOptions.newton_tol", self.newton_tol)
-        if int(self.steps_per_period) < 8:
-            raise ValueError(
-                f"DynamicsOptions.steps_per_period = {self.steps_per_period} is out of range; "
-                "valid range: [8, inf)"
-            )
-        if int(self.newton_max_steps) < 1:
-            raise ValueError(
-                f"DynamicsOptions.newton_max_steps = {self.newton_max_steps} is out of range; "
-                "valid range: [1, inf)"
-            )
+        check_positive("DynamicsOptions.steps_per_mode_period", self.steps_per_mode_period)
+        # Static counts: a float or NaN here would retrace per value or fail inside int().
+        check_integer("DynamicsOptions.steps_per_period", self.steps_per_period, 8)
+        check_integer(
+            "DynamicsOptions.max_steps_per_period",
+            self.max_steps_per_period,
+            max(8, self.steps_per_period) if isinstance(self.steps_per_period, int) else 8,
+        )
+        check_integer("DynamicsOptions.newton_max_steps", self.newton_max_steps, 1)
+        check_integer("DynamicsOptions.newton_batch_steps", self.newton_batch_steps, 1)
+        check_integer("DynamicsOptions.transient_periods", self.transient_periods, 0)
+        check_integer("DynamicsOptions.n_positions", self.n_positions, 4)
 
 
 def backlash_exact(x, half_clearance):

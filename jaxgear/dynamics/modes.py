@@ -12,7 +12,8 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from .._validation import check_positive
+from .._validation import check_instance, check_positive
+from ..gear.pair import GearPair
 
 
 class Modes(eqx.Module):
@@ -48,6 +49,7 @@ def mode_shapes(pair, mesh_stiffness) -> Modes:
 
     Solved as the symmetric eigenproblem of M^(−1/2) K M^(−1/2) (``jnp.linalg.eigh``); differentiable.
     """
+    check_instance("pair", pair, GearPair)
     check_positive("mesh_stiffness", mesh_stiffness, "N/m")
     mass, stiffness, g, km = _matrices(pair, mesh_stiffness)
     s = 1.0 / jnp.sqrt(mass)

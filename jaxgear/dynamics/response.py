@@ -19,7 +19,8 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Bool, Float, Int
 
-from .._validation import check_positive, is_concrete
+from .._validation import check_instance, check_positive, is_concrete
+from ..gear.pair import GearPair
 from ..operating import OperatingPoint
 from .model import (
     LENGTH_SCALE,
@@ -419,6 +420,8 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
 
 
 def _check_inputs(pair, op):
+    check_instance("pair", pair, GearPair)
+    check_instance("op", op, OperatingPoint)
     if is_concrete(op):
         check_positive("OperatingPoint.speed_rpm", op.speed_rpm, "rpm")
         check_positive("OperatingPoint.torque", op.torque, "N m")
@@ -592,7 +595,9 @@ def dynamic_response_sweep(
     options = DynamicsOptions() if options is None else options
     speeds = jnp.asarray(speeds_rpm, dtype=float)
     if speeds.ndim != 1 or speeds.shape[0] < 1:
-        raise ValueError(f"speeds_rpm must be a non-empty 1-D array; got shape {speeds.shape}")
+        raise ValueError(
+            f"speeds_rpm has shape {speeds.shape}; valid: a non-empty 1-D array of speeds, rpm"
+        )
     check_positive("speeds_rpm", speeds, "rpm")
     _check_inputs(pair, op)
     pair, op, mesh, interface, options = _prepare(pair, op, mesh, interface, options)

@@ -13,6 +13,7 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
+from .._validation import check_instance
 from .pair import GearPair
 
 
@@ -50,6 +51,7 @@ class GearGeometry(eqx.Module):
 
 def gear_geometry(pair: GearPair) -> GearGeometry:
     """Geometry of ``pair`` (differentiable in every traced field)."""
+    check_instance("pair", pair, GearPair)
     z = jnp.asarray(pair.teeth, dtype=float)
     r_ref = pair.module * z / 2.0
     rb = r_ref * jnp.cos(pair.pressure_angle)

@@ -7,7 +7,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from .._validation import check_positive, check_range
+from .._validation import check_instance, check_positive, check_range
 from ..material import reduced_modulus
 from .geometry import GearGeometry, gear_geometry, normal_load, radii_of_curvature
 from .load_sharing import DEFAULT_CONTACT_SMOOTHING, share_load
@@ -120,8 +120,17 @@ def mesh_cycle(
         raise ValueError(
             f"n_positions = {n_positions!r} is out of range; valid range: integer >= 4"
         )
+    check_instance("pair", pair, GearPair)
     check_positive("torque", torque, "N m")
+    if jnp.ndim(jnp.asarray(torque)) != 0:
+        raise ValueError(
+            f"torque has shape {jnp.shape(jnp.asarray(torque))}; valid: a scalar, N m (vmap for "
+            "many torques)"
+        )
     check_range("edge_width", edge_width, 0.0, 0.25)
+    # Both smoothing widths divide their argument: zero or negative gives NaN, not a sharp corner.
+    check_range("relief_smoothing", relief_smoothing, 0.0, 1.0, low_inclusive=False)
+    check_range("contact_smoothing", contact_smoothing, 0.0, 1e-5, low_inclusive=False, unit="m")
     if stiffness not in STIFFNESS_METHODS:
         raise ValueError(
             f"stiffness = {stiffness!r} is not valid; valid choices: {STIFFNESS_METHODS}"

@@ -13,6 +13,7 @@ from jaxtyping import Array, Float
 from .._validation import (
     check_choice,
     check_finite,
+    check_instance,
     check_non_negative,
     check_positive,
     check_range,
@@ -21,6 +22,8 @@ from .._validation import (
 from ..material import Material, steel
 
 ReliefShape = Literal["linear", "parabolic"]
+#: Largest tip relief amount, as a fraction of the module (practical reliefs are a few per cent).
+MAX_RELIEF_PER_MODULE = 0.1
 RELIEF_SHAPES = ("linear", "parabolic")
 
 
@@ -188,7 +191,13 @@ class GearPair(eqx.Module):
         if len(tuple(teeth)) != 2:
             raise ValueError(f"teeth must be a pair (z1, z2); got {teeth!r}")
         for name, z in zip(("teeth[0]", "teeth[1]"), teeth):
-            if isinstance(z, bool) or int(z) != z:
+            # NaN, strings and fractions would fail in int() with a message naming no field.
+            if (
+                isinstance(z, bool)
+                or not isinstance(z, int | float | np.integer | np.floating)
+                or not math.isfinite(z)
+                or int(z) != z
+            ):
                 raise ValueError(f"{name} = {z!r} must be an integer; valid range: [5, 10000]")
             check_range(name, z, 5, 10000)
         z1, z2 = int(teeth[0]), int(teeth[1])
@@ -238,7 +247,17 @@ class GearPair(eqx.Module):
 
         if material is None:
             material = steel()
-        self.materials = (material, material) if isinstance(material, Material) else tuple(material)
+        if isinstance(material, Material):
+            material = (material, material)
+        if (
+            not isinstance(material, tuple | list)
+            or len(material) != 2
+            or not all(isinstance(m, Material) for m in material)
+        ):
+            raise ValueError(
+                f"material = {material!r} is not valid; valid: a jaxgear.Material or a pair of them"
+            )
+        self.materials = tuple(material)
 
         r_pitch = r_ref
         rho = jnp.stack([mat.density for mat in self.materials])
@@ -249,8 +268,10 @@ class GearPair(eqx.Module):
             blank_inertia = 0.5 * self.blank_mass * r_pitch**2
         self.blank_inertia = _pair(blank_inertia, "blank_inertia")
         self.bearings = Bearings() if bearings is None else bearings
+        check_instance("bearings", self.bearings, Bearings)
         if tip_relief is None:
             tip_relief = TipRelief(amount=0.0, start_roll_angle=_tip_roll_angles(self))
+        check_instance("tip_relief", tip_relief, TipRelief)
         self.tip_relief = tip_relief
         if bore_radius is None:
             bore_radius = 0.5 * self.root_radius
@@ -317,6 +338,13 @@ def _check_geometry(pair: GearPair) -> None:
             raise ValueError(
                 f"root_radius[{j}] = {rf[j]:.6g} m must be below tip_radius[{j}] = {ra[j]:.6g} m"
             )
+    bore = np.asarray(pair.bore_radius)
+    for j in range(2):
+        if not bore[j] < rf[j]:
+            raise ValueError(
+                f"bore_radius[{j}] = {bore[j]:.6g} m is out of range; valid range: "
+                f"(0, {rf[j]:.6g}) m (below the root radius of gear {j + 1})"
+            )
     a_w = float(pair.centre_distance)
     if not a_w > rb.sum():
         raise ValueError(
@@ -338,6 +366,14 @@ def _check_geometry(pair: GearPair) -> None:
     tr = pair.tip_relief
     start = np.asarray(tr.start_roll_angle)
     amount = np.asarray(tr.amount)
+    top = MAX_RELIEF_PER_MODULE * float(pair.module)
+    for j in range(2):
+        if not amount[j] <= top:
+            raise ValueError(
+                f"tip_relief.amount[{j}] = {amount[j]:.6g} m is out of range; valid range: "
+                f"[0, {top:.6g}] m ({MAX_RELIEF_PER_MODULE:g} x module: deeper is another tooth "
+                "form, not a profile modification)"
+            )
     lo = np.asarray([geo.roll_angle_start_active[0], geo.roll_angle_start_active[1]])
     hi = np.asarray(geo.roll_angle_tip)
     for j in range(2):

@@ -71,6 +71,11 @@ class Surfaces(eqx.Module):
         check_positive("Surfaces.dx", self.dx, "m")
         check_non_negative("Surfaces.scale", self.scale)
         check_finite("Surfaces.offset", self.offset)
+        if jnp.shape(self.offset) != (2,):
+            raise ValueError(
+                f"Surfaces.offset has shape {jnp.shape(self.offset)}; valid: shape (2,), one "
+                "offset per gear (m)"
+            )
 
     # -- statistics -------------------------------------------------------------------------------
     @property
@@ -230,6 +235,8 @@ def synthetic(
     correlation_length: float = DEFAULT_CORRELATION_LENGTH,
 ) -> Surfaces:
     """Two independent synthetic Gaussian profiles of Rq ``rq`` (m) each, seeded by ``seed``."""
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ValueError(f"seed = {seed!r} is out of range; valid range: integer >= 0")
     z1, z2 = _seeded_pair(seed, n, dx, rq, correlation_length)
     return Surfaces(profile1=z1, profile2=z2, dx=dx, scale=scale)
 
