@@ -131,6 +131,17 @@ class Fidelity(eqx.Module):
         return cls(**base)
 
     @classmethod
+    def auto(cls, pair, lubricant, surfaces, op, tolerance: float = 0.05, **options) -> Fidelity:
+        """The cheapest rungs whose measured error stays under ``tolerance`` for this scenario.
+
+        Logic, options and the measured table: ``jaxgear.fidelity_auto``. A Fidelity is static, so
+        the reasons travel separately: ``jg.choose_fidelity`` (same arguments) returns them.
+        """
+        from .fidelity_auto import auto_fidelity
+
+        return auto_fidelity(pair, lubricant, surfaces, op, tolerance, **options)
+
+    @classmethod
     def named(cls, name: str, **changes) -> Fidelity:
         """A preset by name: "fast" or "paper" (the names the command line accepts)."""
         presets = {"fast": cls.fast, "paper": cls.paper}

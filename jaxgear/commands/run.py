@@ -60,7 +60,17 @@ def register(sub) -> None:
     )
     p.add_argument("--surfaces", choices=("ground", "polished", "smooth"), default="ground")
     p.add_argument(
-        "--fidelity", choices=("fast",), default="fast", help="fidelity preset (default fast)"
+        "--fidelity",
+        choices=("fast", "paper", "auto"),
+        default="fast",
+        help="fidelity (default fast); auto: the cheapest rungs whose measured error stays under "
+        "--tolerance over this sweep (jg.Fidelity.auto), with its reasons printed",
+    )
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.05,
+        help="relative error tolerance of --fidelity auto on the power loss (default 0.05)",
     )
     p.add_argument("--chunk-size", type=int, default=50, help="speeds per chunk (default 50)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -69,7 +79,6 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import jaxgear as jg
-    from jaxgear.fidelity import Fidelity
     from jaxgear.plotting import plot_dte_rms, plot_efficiency, plot_power_loss
     from jaxgear.sweep import sweep
 
@@ -84,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
         speed_rpm=float(speeds[0]),
         inlet_temperature=args.inlet_temperature + 273.15,
     )
-    fid = Fidelity.fast()
+    fid, reasons = _fidelity(args, pair, lub, surf, op, speeds)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -124,6 +133,8 @@ def run(args: argparse.Namespace) -> int:
     plot_power_loss(speeds, parts(td), parts(qs), out / "power_loss.png", ok=td.converged)
     plot_efficiency(speeds, td.efficiency, qs.efficiency, out / "efficiency.png", ok=td.converged)
     summary = _summary(speeds, td, qs, fid, args, t_td, t_all)
+    if reasons:
+        summary["inputs"]["fidelity_reasons"] = reasons
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     print(json.dumps(summary["headline"], indent=1))
     print(
@@ -137,6 +148,19 @@ def run(args: argparse.Namespace) -> int:
             "summary.json: e.g. no stable periodic orbit where the teeth rattle)"
         )
     return 0
+
+
+def _fidelity(args, pair, lub, surf, op, speeds):
+    """(Fidelity, reasons or None) for ``--fidelity``; auto prints its reasons."""
+    from jaxgear.fidelity import Fidelity
+
+    if args.fidelity != "auto":
+        return Fidelity.named(args.fidelity), None
+    from jaxgear.fidelity_auto import choose_fidelity
+
+    choice = choose_fidelity(pair, lub, surf, op, args.tolerance, speeds_rpm=speeds)
+    print(choice.reasons, flush=True)
+    return choice.fidelity, choice.reasons
 
 
 def _default_pair(jg):
