@@ -132,8 +132,12 @@ def scaled_step(carry, inp, args):
 def test_shared_args_reuse_the_compiled_chunk_and_enter_the_fingerprint(tmp_path):
     xs = np.arange(6.0)
     TRACES.clear()
-    one = run_points(scaled, {"x": xs}, args={"a": jnp.asarray(2.0)}, chunk_size=3, converged_key=None)
-    two = run_points(scaled, {"x": xs}, args={"a": jnp.asarray(3.0)}, chunk_size=3, converged_key=None)
+    one = run_points(
+        scaled, {"x": xs}, args={"a": jnp.asarray(2.0)}, chunk_size=3, converged_key=None
+    )
+    two = run_points(
+        scaled, {"x": xs}, args={"a": jnp.asarray(3.0)}, chunk_size=3, converged_key=None
+    )
     np.testing.assert_array_equal(one.outputs["y"], 2 * xs)
     np.testing.assert_array_equal(two.outputs["y"], 3 * xs)
     assert len(TRACES) == 1  # the second sweep reused the first one's compiled chunk
