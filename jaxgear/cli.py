@@ -12,7 +12,7 @@ import importlib
 import sys
 
 # Subcommand modules, in the order shown by --help.
-COMMANDS = ("run", "sweep", "mesh", "ehl", "optimise")
+COMMANDS = ("run", "sweep", "figures", "mesh", "ehl", "optimise")
 
 
 def build_parser() -> argparse.ArgumentParser:
