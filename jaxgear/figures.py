@@ -626,13 +626,19 @@ def _fields_figure(repro, number, keys, title):
             title=f"{f.label}: {f.speed_rpm:.0f} rpm, {f.roll_angle_deg:.2f}°, "
             f"ph {f.hertz_pressure / 1e9:.2f} GPa",
         )
-        axes[1, col].plot(x, np.asarray(sol.h) * 1e6)
-        axes[1, col].set(ylabel="h (µm)")
+        h = np.asarray(sol.h) * 1e6
+        axes[1, col].plot(x, h)
+        # The inlet gap grows to tens of µm: scale to the film inside the contact.
+        inside = np.abs(x) <= 1.0
+        top = 3.0 * float(np.max(h[inside])) if inside.any() else float(np.max(h))
+        axes[1, col].set(ylabel="h (µm)", ylim=(0.0, top))
         if thermal:
             rise = np.asarray(sol.temperature) - float(repro.op.inlet_temperature)
             axes[2, col].plot(x, rise)
             axes[2, col].set(ylabel="film temperature rise (K)")
         axes[-1, col].set(xlabel="x / b (Hertz half-widths)")
+        for ax in axes[:, col]:
+            ax.set_xlim(-2.5, 1.5)
     note = "" if thermal else " (no temperatures: iso-thermal fidelity)"
     return _finish(fig, axes.flat, f"Fig. {number}: {title}{note}\n{_subtitle(repro)}")
 
@@ -1000,9 +1006,9 @@ def table_markdown(rows: list[dict]) -> str:
 
 
 def write_report(repro: PaperReproduction, out_dir: str | Path) -> dict:
-    """Write the figures (PNG), ``paper_table.md`` / ``paper_table.json`` (R1-R11) and
-    ``figures.json`` (what was written, what was skipped and why, the points, the timings) into
-    ``out_dir``. Returns the contents of figures.json."""
+    """Write the figures (PNG), ``paper_table.md`` / ``paper_table.json`` (R1-R11), the sweeps as CSV
+    (``data/``) and ``figures.json`` (what was written, what was skipped and why, the points, the
+    timings) into ``out_dir``. Returns the contents of figures.json."""
     import json
 
     out = Path(out_dir)
@@ -1016,6 +1022,13 @@ def write_report(repro: PaperReproduction, out_dir: str | Path) -> dict:
         + f" ({repro.points_source}). † = not converged (kept, flagged).\n\n"
     )
     (out / "paper_table.md").write_text(header + table_markdown(rows) + "\n")
+    data = out / "data"
+    data.mkdir(exist_ok=True)
+    csvs = [repro.tribo_dynamic.to_csv(data / "baseline_tribo_dynamic.csv")]
+    csvs.append(repro.quasi_static.to_csv(data / "baseline_quasi_static.csv"))
+    for name, result in repro.variants.items():
+        if name != "baseline":
+            csvs.append(result.to_csv(data / f"variant_{name}.csv"))
     (out / "paper_table.json").write_text(json.dumps(rows, indent=1))
     manifest = {
         "fidelity": {f.name: getattr(fid, f.name) for f in dataclasses.fields(fid)},
@@ -1037,6 +1050,7 @@ def write_report(repro: PaperReproduction, out_dir: str | Path) -> dict:
         "written": {f"Fig. {n}": p.name for n, p in written.items()},
         "skipped": {f"Fig. {n}": reason for n, reason in skipped.items()},
         "tables": ["paper_table.md", "paper_table.json"],
+        "data": [f"data/{p.name}" for p in csvs],
         "timings_s": repro.timings,
         "not_converged": {
             name: int(np.sum(~np.asarray(r.converged)))

@@ -172,6 +172,8 @@ def _check_figure_outputs(out, stdout, drawn, skipped):
             assert r["note"], r["id"]  # why it was not judged
     md = (out / "paper_table.md").read_text()
     assert all(f"| {i} |" in md for i in R_IDS)
+    for name in manifest["data"]:
+        assert len((out / name).read_text().splitlines()) == 8, name  # header + seven speeds
     return manifest, {r["id"]: r for r in rows}
 
 

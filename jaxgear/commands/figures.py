@@ -4,7 +4,8 @@ Runs the baseline speed sweep (500-4200 rpm, 25 rpm steps, ground, 700 N m, 90 �
 quasi-static, the paper's variants (inlet 60 °C, 1500 N m, polished; iso-thermal at a thermal
 fidelity) every 100 rpm, and the contact fields at 25° and 17° roll angle; writes to ``--out``
 (default ``results/figures``) the PNG figures, ``paper_table.md`` / ``paper_table.json`` (R1-R11, the
-paper's value beside jaxgear's) and ``figures.json`` (what was written, what was skipped and why).
+paper's value beside jaxgear's), the sweeps as CSV in ``data/`` and ``figures.json`` (what was
+written, what was skipped and why).
 A figure the fidelity cannot give (temperatures need the thermal rung, asperity pressures the mixed
 rung) is skipped with the reason printed, never drawn from something else. ``--quick``: seven speeds
 (the points A-E at nominal speeds and the sweep's ends), 24 positions per mesh cycle.
@@ -57,6 +58,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {fig}: {out / name}")
     for fig, reason in manifest["skipped"].items():
         print(f"skipped {fig}: {reason}")
-    print(f"wrote {out / 'paper_table.md'}, paper_table.json, figures.json")
+    print(f"wrote {out / 'paper_table.md'}, paper_table.json, figures.json, data/*.csv")
     print(f"wall time {time.perf_counter() - t0:.0f} s")
     return 0
