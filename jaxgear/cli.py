@@ -12,7 +12,7 @@ import importlib
 import sys
 
 # Subcommand modules, in the order shown by --help.
-COMMANDS = ("run", "mesh", "ehl", "optimise")
+COMMANDS = ("run", "sweep", "figures", "mesh", "ehl", "optimise")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -6,7 +6,8 @@ line can report them with exit code 2.
 Schema (every table and key optional; missing ``[gear]`` means the paper's pair)::
 
     [gear]
-    preset = "li2015"            # base to override (default "li2015"; "none" = all keys given)
+    preset = "li2015"            # base to override: "li2015", "li2015_calibrated" (blanks tuned to
+                                 # the paper's resonances) or "none" (all keys given)
     teeth = [50, 50]
     module_mm = 3.0
     pressure_angle_deg = 20.0
@@ -35,14 +36,20 @@ Schema (every table and key optional; missing ``[gear]`` means the paper's pair)
 
     [operating]
     torque_Nm = 700.0
+
+``jaxgear sweep`` adds ``[lubricant]``, ``[surfaces]``, ``[fidelity]`` and ``[sweep]`` (see
+``sweep_from_config`` and ``examples/sweep.toml``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from .gear.pair import Bearings, GearPair, TipRelief
 
@@ -94,11 +101,14 @@ def check_keys(table: dict, allowed: dict, where: str) -> None:
         kinds = allowed[key] if isinstance(allowed[key], tuple) else (allowed[key],)
         ok = any(_is_kind(value, kind) for kind in kinds)
         if not ok:
-            names = " or ".join("number" if k is float else k.__name__ for k in kinds)
+            word = {float: "number", int: "integer", bool: "true or false", str: "string"}
+            names = " or ".join(word.get(k, k.__name__) for k in kinds)
             raise ValueError(f"{where}.{key} = {value!r} has the wrong type; expected {names}")
 
 
 def _is_kind(value, kind) -> bool:
+    if kind is int:
+        return isinstance(value, int) and not isinstance(value, bool)
     if kind is float:
         return isinstance(value, int | float) and not isinstance(value, bool)
     if kind is list:
@@ -116,15 +126,21 @@ def _scaled(value, factor):
     return float(value) * factor
 
 
-def gear_pair_from_config(cfg: dict[str, Any]) -> GearPair:
+GEAR_PRESETS = ("li2015", "li2015_calibrated", "none")
+
+
+def gear_pair_from_config(cfg: dict[str, Any], default_preset: str = "li2015") -> GearPair:
     """Build a GearPair from the ``[gear]`` table of a config dict (see the module docstring)."""
     from . import presets
 
     gear = dict(cfg.get("gear", {}))
     check_keys(gear, _GEAR_KEYS, "gear")
-    preset = gear.pop("preset", "li2015")
-    if preset not in ("li2015", "none"):
-        raise ValueError(f"gear.preset = {preset!r} is not valid; valid choices: 'li2015', 'none'")
+    preset = gear.pop("preset", default_preset)
+    if preset not in GEAR_PRESETS:
+        raise ValueError(
+            f"gear.preset = {preset!r} is not valid; valid choices: "
+            + ", ".join(map(repr, GEAR_PRESETS))
+        )
     relief_cfg = gear.pop("tip_relief", None)
     bearing_cfg = gear.pop("bearings", None)
     if relief_cfg is not None:
@@ -132,8 +148,8 @@ def gear_pair_from_config(cfg: dict[str, Any]) -> GearPair:
     if bearing_cfg is not None:
         check_keys(bearing_cfg, _BEARING_KEYS, "gear.bearings")
 
-    if preset == "li2015":
-        base = presets.li2015_pair()
+    if preset in ("li2015", "li2015_calibrated"):
+        base = presets.li2015_pair() if preset == "li2015" else presets.li2015_pair_calibrated()
         kwargs: dict[str, Any] = dict(
             teeth=base.teeth,
             module=base.module,
@@ -146,10 +162,18 @@ def gear_pair_from_config(cfg: dict[str, Any]) -> GearPair:
             bearings=base.bearings,
             tip_relief=base.tip_relief,
         )
+        if preset == "li2015_calibrated":
+            kwargs.update(blank_mass=base.blank_mass, blank_inertia=base.blank_inertia)
         # Changing the basic geometry invalidates the preset's explicit radii and centre distance.
         if any(k in gear for k in ("teeth", "module_mm", "pressure_angle_deg", "profile_shift")):
-            for k in ("tip_radius", "root_radius", "centre_distance"):
-                kwargs.pop(k)
+            for k in (
+                "tip_radius",
+                "root_radius",
+                "centre_distance",
+                "blank_mass",
+                "blank_inertia",
+            ):
+                kwargs.pop(k, None)
     else:
         for required in ("teeth", "module_mm", "pressure_angle_deg", "face_width_mm"):
             if required not in gear:
@@ -225,3 +249,309 @@ def check_top_level(cfg: dict[str, Any], allowed: tuple[str, ...]) -> None:
     for key in cfg:
         if key not in allowed:
             raise ValueError(f"unknown table [{key}] in config; valid tables: {', '.join(allowed)}")
+
+
+# ---------------------------------------------------------------------------------------------------
+# ``jaxgear sweep``: the whole of jg.sweep's inputs from one TOML file.
+
+SWEEP_TABLES = ("gear", "lubricant", "surfaces", "operating", "fidelity", "sweep")
+LUBRICANT_PRESETS = ("mil_l_23699", "iso_vg68")
+SURFACE_PRESETS = ("ground", "polished", "smooth")
+FIDELITY_PRESETS = ("fast", "paper")
+_SURFACE_KEYS = {
+    "preset": str,
+    "scale": float,
+    "seed": int,
+    "rq_um": float,
+    "correlation_length_um": float,
+}
+_SWEEP_KEYS = {
+    "speeds_rpm": list,
+    "speed_range_rpm": list,
+    "mode": str,
+    "chunk_size": int,
+    "checkpoint": bool,
+    "quasi_static_reference": bool,
+    "progress": bool,
+    "vary": dict,
+}
+# Other inputs varied point by point, at the edge units of the TOML → (jg.sweep name, factor, offset).
+_VARY_KEYS = {
+    "torque_Nm": ("torque", 1.0, 0.0),
+    "inlet_temperature_C": ("inlet_temperature", 1.0, 273.15),
+    "roughness_scale": ("roughness_scale", 1.0, 0.0),
+    "tip_relief_um": ("tip_relief_amount", 1e-6, 0.0),
+}
+MAX_SWEEP_POINTS = 100_000
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepConfig:
+    """Everything ``jaxgear sweep`` needs, in SI (speeds in rpm), plus ``echo``: the resolved inputs
+    at the edge units, for the summary. Built by ``sweep_from_config``."""
+
+    pair: Any
+    lubricant: Any
+    surfaces: Any
+    op: Any
+    fidelity: Any
+    speeds: np.ndarray
+    vary: dict
+    mode: str
+    chunk_size: int
+    checkpoint: bool
+    quasi_static_reference: bool
+    progress: bool
+    echo: dict
+
+
+def _lubricant_keys() -> dict:
+    from .lubrication.lubricant import Lubricant
+
+    keys: dict[str, Any] = {"preset": str}
+    for f in dataclasses.fields(Lubricant):
+        keys[f.name] = str if f.name == "temperature_model" else float
+    return keys
+
+
+def lubricant_from_config(cfg: dict[str, Any]):
+    """``[lubricant]``: ``preset`` ("mil_l_23699" or "iso_vg68") and any ``jg.Lubricant`` field to
+    override, in that class's SI units (e.g. ``kinematic_viscosity_40 = 2.5e-5`` m²/s,
+    ``eyring_stress = 5e6`` Pa)."""
+    from . import presets
+
+    table = dict(cfg.get("lubricant", {}))
+    check_keys(table, _lubricant_keys(), "lubricant")
+    name = table.pop("preset", "mil_l_23699")
+    if name not in LUBRICANT_PRESETS:
+        raise ValueError(
+            f"lubricant.preset = {name!r} is not valid; valid choices: "
+            + ", ".join(map(repr, LUBRICANT_PRESETS))
+        )
+    lub = getattr(presets, name)()
+    if table:
+        try:
+            lub = dataclasses.replace(lub, **table)
+        except ValueError as err:
+            raise ValueError(str(err).replace("Lubricant.", "lubricant.")) from None
+    return lub, {"preset": name, **table}
+
+
+def surfaces_from_config(cfg: dict[str, Any]):
+    """``[surfaces]``: ``preset`` ("ground", "polished", "smooth"), ``scale`` (≥ 0), ``seed`` of the
+    synthetic profiles, and optionally ``rq_um`` / ``correlation_length_um`` for other synthetic
+    Gaussian profiles (REFERENCE §6)."""
+    from . import presets
+    from ._validation import check_non_negative, check_positive
+    from .lubrication import roughness
+
+    table = dict(cfg.get("surfaces", {}))
+    check_keys(table, _SURFACE_KEYS, "surfaces")
+    name = table.get("preset", "ground")
+    if name not in SURFACE_PRESETS:
+        raise ValueError(
+            f"surfaces.preset = {name!r} is not valid; valid choices: "
+            + ", ".join(map(repr, SURFACE_PRESETS))
+        )
+    scale = float(table.get("scale", 1.0))
+    check_non_negative("surfaces.scale", scale)
+    seed = table.get("seed", 0)
+    if seed < 0:
+        raise ValueError(f"surfaces.seed = {seed} is out of range; valid range: integer >= 0")
+    kwargs = {}
+    if "correlation_length_um" in table:
+        check_positive("surfaces.correlation_length_um", table["correlation_length_um"], "µm")
+        kwargs["correlation_length"] = table["correlation_length_um"] * 1e-6
+    if name == "smooth":
+        extra = sorted(set(table) - {"preset"})
+        if extra:
+            raise ValueError(
+                f"surfaces.{extra[0]} has no meaning with surfaces.preset = 'smooth'; remove it"
+            )
+        surf = presets.smooth()
+    elif "rq_um" in table:
+        check_non_negative("surfaces.rq_um", table["rq_um"], "µm")
+        surf = roughness.synthetic(table["rq_um"] * 1e-6, scale=scale, seed=seed, **kwargs)
+    else:
+        surf = getattr(presets, name)(scale=scale, seed=seed, **kwargs)
+    return surf, {"preset": name, "scale": scale, "seed": seed} | {
+        k: table[k] for k in ("rq_um", "correlation_length_um") if k in table
+    }
+
+
+def _fidelity_keys() -> dict:
+    from .fidelity import Fidelity
+
+    keys: dict[str, Any] = {"preset": str}
+    for f in dataclasses.fields(Fidelity):
+        keys[f.name] = {bool: bool, int: int, float: float, str: str}[type(f.default)]
+    return keys
+
+
+def fidelity_from_config(cfg: dict[str, Any], preset: str | None = None):
+    """``[fidelity]``: ``preset`` ("fast" or "paper"; ``preset`` given here, e.g. from the command
+    line, wins) and any ``jg.Fidelity`` field to override (``n_positions = 24``,
+    ``dynamics = "quasi_static"``...)."""
+    from .fidelity import Fidelity
+
+    table = dict(cfg.get("fidelity", {}))
+    check_keys(table, _fidelity_keys(), "fidelity")
+    name = preset if preset is not None else table.get("preset", "fast")
+    table.pop("preset", None)
+    if name not in FIDELITY_PRESETS:
+        raise ValueError(
+            f"fidelity preset = {name!r} is not valid; valid choices: "
+            + ", ".join(map(repr, FIDELITY_PRESETS))
+        )
+    try:
+        fid = Fidelity.named(name, **table)
+    except ValueError as err:
+        raise ValueError(str(err).replace("Fidelity.", "fidelity.")) from None
+    return fid, {"preset": name, **table}
+
+
+def _speeds(table) -> np.ndarray:
+    from ._validation import check_positive
+
+    if ("speeds_rpm" in table) == ("speed_range_rpm" in table):
+        raise ValueError(
+            "[sweep] needs exactly one of speeds_rpm = [list of rpm] or "
+            "speed_range_rpm = [start, stop, step]"
+        )
+    if "speeds_rpm" in table:
+        speeds = table["speeds_rpm"]
+        if not speeds or not all(_is_kind(v, float) for v in speeds):
+            raise ValueError(f"sweep.speeds_rpm = {speeds!r} must be a non-empty list of numbers")
+        speeds = np.asarray(speeds, dtype=float)
+        check_positive("sweep.speeds_rpm", speeds, "rpm")
+        return speeds
+    rng = table["speed_range_rpm"]
+    if len(rng) != 3 or not all(_is_kind(v, float) for v in rng):
+        raise ValueError(
+            f"sweep.speed_range_rpm = {rng!r} must be [start, stop, step] in rpm, "
+            "e.g. [500, 4200, 25]"
+        )
+    start, stop, step = (float(v) for v in rng)
+    if not (start > 0 and stop >= start and step > 0):
+        raise ValueError(
+            f"sweep.speed_range_rpm = {rng!r} is out of range; valid range: "
+            "0 < start <= stop, step > 0 (rpm)"
+        )
+    if (stop - start) / step + 1 > MAX_SWEEP_POINTS:
+        raise ValueError(
+            f"sweep.speed_range_rpm = {rng!r} gives more than {MAX_SWEEP_POINTS} points; "
+            "valid range: at most that many"
+        )
+    return np.arange(start, stop + 0.5 * step, step)
+
+
+def _vary(table, n) -> tuple[dict, dict]:
+    from ._validation import check_non_negative, check_positive, check_range
+
+    vary = dict(table.get("vary", {}))
+    check_keys(vary, {k: (float, list) for k in _VARY_KEYS}, "sweep.vary")
+    out, echo = {}, {}
+    for key, value in vary.items():
+        arr = np.atleast_1d(np.asarray(value, dtype=float))
+        if arr.size not in (1, n):
+            raise ValueError(
+                f"sweep.vary.{key} has {arr.size} values; valid: 1 or one per speed ({n})"
+            )
+        where = f"sweep.vary.{key}"
+        if key == "torque_Nm":
+            check_positive(where, arr, "N m")
+        elif key == "inlet_temperature_C":
+            check_range(where, arr, -73.15, 326.85, unit="°C")
+        else:
+            check_non_negative(where, arr)
+        name, factor, offset = _VARY_KEYS[key]
+        out[name] = arr * factor + offset
+        echo[key] = value
+    return out, echo
+
+
+def sweep_from_config(cfg: dict[str, Any], fidelity: str | None = None) -> SweepConfig:
+    """Resolve a ``jaxgear sweep`` config (examples/sweep.toml shows every key):
+
+    - ``[gear]`` as for ``jaxgear mesh`` (default preset "li2015_calibrated", the pair of ``jaxgear
+      run``); ``[lubricant]``, ``[surfaces]``, ``[fidelity]``: see their ``*_from_config``.
+    - ``[operating]``: ``torque_Nm`` (default 700), ``inlet_temperature_C`` (default 90); the speeds
+      come from ``[sweep]``.
+    - ``[sweep]``: ``speeds_rpm = [...]`` or ``speed_range_rpm = [start, stop, step]``; ``mode``
+      ("continuation", the paper's stepwise speed increase, default; or "parallel"); ``chunk_size``
+      (default 50); ``checkpoint`` (default true: finished chunks in ``<out>/checkpoint`` so an
+      interrupted sweep resumes); ``quasi_static_reference`` (default true for a tribo-dynamic sweep:
+      also sweep the quasi-static model, as the paper's Fig. 4 compares them); ``progress`` (default
+      true); ``[sweep.vary]``: ``torque_Nm``, ``inlet_temperature_C``, ``roughness_scale``,
+      ``tip_relief_um`` per speed (a list as long as the speeds) or one value.
+
+    Raises ValueError naming the key, the value and the valid range.
+    """
+    from ._validation import check_positive, check_range
+    from .operating import OperatingPoint
+
+    check_top_level(cfg, SWEEP_TABLES)
+    pair = gear_pair_from_config(cfg, default_preset="li2015_calibrated")
+    lub, lub_echo = lubricant_from_config(cfg)
+    surf, surf_echo = surfaces_from_config(cfg)
+    fid, fid_echo = fidelity_from_config(cfg, fidelity)
+
+    op_table = dict(cfg.get("operating", {}))
+    check_keys(op_table, _OPERATING_KEYS, "operating")
+    if "speed_rpm" in op_table:
+        raise ValueError(
+            "operating.speed_rpm is not used by jaxgear sweep; give the speeds in [sweep] "
+            "(speeds_rpm or speed_range_rpm)"
+        )
+    torque = float(op_table.get("torque_Nm", 700.0))
+    inlet_c = float(op_table.get("inlet_temperature_C", 90.0))
+    check_positive("operating.torque_Nm", torque, "N m")
+    check_range("operating.inlet_temperature_C", inlet_c, -73.15, 326.85, unit="°C")
+
+    table = dict(cfg.get("sweep", {}))
+    check_keys(table, _SWEEP_KEYS, "sweep")
+    speeds = _speeds(table)
+    vary, vary_echo = _vary(table, speeds.size)
+    mode = table.get("mode", "continuation")
+    if mode not in ("continuation", "parallel"):
+        raise ValueError(
+            f"sweep.mode = {mode!r} is not valid; valid choices: 'continuation', 'parallel'"
+        )
+    chunk = table.get("chunk_size", 50)
+    if chunk < 1:
+        raise ValueError(f"sweep.chunk_size = {chunk} is out of range; valid range: integer >= 1")
+    reference = table.get("quasi_static_reference", fid.dynamics == "tribo_dynamic")
+    if reference and fid.dynamics == "quasi_static":
+        reference = False  # the sweep is the quasi-static model already
+    op = OperatingPoint(
+        torque=torque, speed_rpm=float(speeds[0]), inlet_temperature=inlet_c + 273.15
+    )
+    echo = {
+        "gear": dict(cfg.get("gear", {})) or {"preset": "li2015_calibrated"},
+        "lubricant": lub_echo,
+        "surfaces": surf_echo,
+        "operating": {"torque_Nm": torque, "inlet_temperature_C": inlet_c},
+        "fidelity": fid_echo,
+        "sweep": {
+            "speeds_rpm": [float(speeds[0]), float(speeds[-1]), int(speeds.size)],
+            "mode": mode,
+            "chunk_size": chunk,
+            "quasi_static_reference": bool(reference),
+            "vary": vary_echo,
+        },
+    }
+    return SweepConfig(
+        pair=pair,
+        lubricant=lub,
+        surfaces=surf,
+        op=op,
+        fidelity=fid,
+        speeds=speeds,
+        vary=vary,
+        mode=mode,
+        chunk_size=chunk,
+        checkpoint=table.get("checkpoint", True),
+        quasi_static_reference=bool(reference),
+        progress=table.get("progress", True),
+        echo=echo,
+    )

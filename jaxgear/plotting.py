@@ -111,16 +111,19 @@ def plot_dte_rms(speeds_rpm, dte_rms, path, *, label="tribo-dynamic", others=(),
     return Path(path)
 
 
-def plot_power_loss(speeds_rpm, dynamic, quasi_static, path, ok=None):
+def plot_power_loss(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=None):
     """Cycle-mean power loss against speed: sliding, rolling and total, tribo-dynamic against
     quasi-static (like the paper's Fig. 4a). ``dynamic``/``quasi_static``: dicts with keys
-    "total", "sliding", "rolling" (W)."""
+    "total", "sliding", "rolling" (W); ``quasi_static`` may be None (one model only). ``labels``:
+    names of the two models (default "tribo-dynamic", "quasi-static")."""
     plt = _pyplot()
+    first, second = labels or ("tribo-dynamic", "quasi-static")
     fig, ax = plt.subplots(figsize=(7, 4.5))
     styles = {"total": "-", "sliding": "--", "rolling": ":"}
     for key, ls in styles.items():
-        ax.plot(speeds_rpm, dynamic[key], ls, color="C0", label=f"{key}, tribo-dynamic")
-        ax.plot(speeds_rpm, quasi_static[key], ls, color="C1", label=f"{key}, quasi-static")
+        ax.plot(speeds_rpm, dynamic[key], ls, color="C0", label=f"{key}, {first}")
+        if quasi_static is not None:
+            ax.plot(speeds_rpm, quasi_static[key], ls, color="C1", label=f"{key}, {second}")
     _mark_flagged(ax, speeds_rpm, dynamic["total"], ok)
     _paper_points(ax)
     ax.set(xlabel="gear 1 speed (rpm)", ylabel="Φ̄ (W)", title="Mesh power loss")
@@ -132,12 +135,15 @@ def plot_power_loss(speeds_rpm, dynamic, quasi_static, path, ok=None):
     return Path(path)
 
 
-def plot_efficiency(speeds_rpm, dynamic, quasi_static, path, ok=None):
-    """Mesh efficiency Ψ (%) against speed, tribo-dynamic against quasi-static (paper's Fig. 4b)."""
+def plot_efficiency(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=None):
+    """Mesh efficiency Ψ (%) against speed, tribo-dynamic against quasi-static (paper's Fig. 4b);
+    ``quasi_static`` may be None. ``labels``: names of the two models."""
     plt = _pyplot()
+    first, second = labels or ("tribo-dynamic", "quasi-static")
     fig, ax = plt.subplots(figsize=(7, 4))
-    ax.plot(speeds_rpm, 100 * np.asarray(dynamic), "-", label="tribo-dynamic")
-    ax.plot(speeds_rpm, 100 * np.asarray(quasi_static), "--", label="quasi-static")
+    ax.plot(speeds_rpm, 100 * np.asarray(dynamic), "-", label=first)
+    if quasi_static is not None:
+        ax.plot(speeds_rpm, 100 * np.asarray(quasi_static), "--", label=second)
     _mark_flagged(ax, speeds_rpm, 100 * np.asarray(dynamic), ok)
     _paper_points(ax)
     ax.set(xlabel="gear 1 speed (rpm)", ylabel="Ψ (%)", title="Mesh efficiency")

@@ -40,6 +40,8 @@ _SCALARS = (
     "dte_rms",
     "fixed_point_residual",
 )
+# Per-position outputs kept for every point (paper Figs. 5-7, 12 need them at chosen speeds).
+_PER_POSITION = ("power_loss_position", "tooth_force", "surface_velocity", "hertz_pressure")
 
 
 class SweepResult(eqx.Module):
@@ -50,6 +52,8 @@ class SweepResult(eqx.Module):
         power_loss, power_loss_sliding, power_loss_rolling (W), efficiency, dte_rms (m),
         fixed_point_residual: [N] (NaN where a point failed).
         power_loss_position: Φ(t_i) per point, W [N, M].
+        tooth_force: W_T per point, position and pair slot, N [N, M, 2]; surface_velocity: uj, m/s
+            [N, M, 2, 2]; hertz_pressure: Hertz pressure of W_T, Pa [N, M, 2] (as in SimulationResult).
         status: per point, the simulation status (0 ok; see ``tribodynamics.STATUS_NAMES``), or 5 where
             the point's chunk raised or its outputs were not finite.
         converged: status == 0.
@@ -64,6 +68,9 @@ class SweepResult(eqx.Module):
     dte_rms: np.ndarray
     fixed_point_residual: np.ndarray
     power_loss_position: np.ndarray
+    tooth_force: np.ndarray
+    surface_velocity: np.ndarray
+    hertz_pressure: np.ndarray
     status: np.ndarray
     messages: tuple[str, ...] = eqx.field(static=True, default=())
 
@@ -125,10 +132,33 @@ def _apply(pair, surfaces, op, point):
 
 def _outputs(result):
     out = {k: getattr(result, k) for k in _SCALARS}
-    out["power_loss_position"] = result.power_loss_position
+    for k in _PER_POSITION:
+        out[k] = getattr(result, k)
     out["sim_status"] = result.status
     out["converged"] = result.converged
     return out
+
+
+# Module-level point and step functions taking the shared inputs as an argument: the sweep engine keeps
+# their compiled chunks, so a second sweep (another torque, lubricant, surface finish...) with the same
+# fidelity and shapes does not compile again.
+def _point(point, shared):
+    pair, lubricant, surfaces, op, fidelity = shared
+    p, s, o = _apply(pair, surfaces, op, point)
+    return _outputs(simulate_with_state(p, lubricant, s, o, fidelity)[0])
+
+
+def _step(warm, point, shared):
+    pair, lubricant, surfaces, op, fidelity = shared
+    p, s, o = _apply(pair, surfaces, op, point)
+    result, new_warm = simulate_with_state(p, lubricant, s, o, fidelity, warm)
+    # A failed point must not poison the rest of the march: keep the last good state.
+    good = result.converged
+    carry = jax.tree_util.tree_map(lambda a, b: jnp.where(good, a, b), new_warm, warm)
+    return carry, _outputs(result)
+
+
+_first_state = eqx.filter_jit(simulate_with_state)
 
 
 def sweep(
@@ -209,14 +239,12 @@ def sweep(
         inputs[k] = arr
     _validate_points(pair, surfaces, op, inputs)
 
-    def point_fn(point):
-        p, s, o = _apply(pair, surfaces, op, point)
-        return _outputs(simulate_with_state(p, lubricant, s, o, fidelity)[0])
-
+    shared = (pair, lubricant, surfaces, op, fidelity)
     if mode == "parallel":
         raw = run_points(
-            point_fn,
+            _point,
             inputs,
+            args=shared,
             chunk_size=chunk_size,
             checkpoint_dir=checkpoint_dir,
             progress=progress,
@@ -226,20 +254,12 @@ def sweep(
     else:
         first = jax.tree_util.tree_map(lambda x: jnp.asarray(x[0]), inputs)
         p0, s0, o0 = _apply(pair, surfaces, op, first)
-        _, warm0 = eqx.filter_jit(simulate_with_state)(p0, lubricant, s0, o0, fidelity)
-
-        def step(warm, point):
-            p, s, o = _apply(pair, surfaces, op, point)
-            result, new_warm = simulate_with_state(p, lubricant, s, o, fidelity, warm)
-            # A failed point must not poison the rest of the march: keep the last good state.
-            good = result.converged
-            carry = jax.tree_util.tree_map(lambda a, b: jnp.where(good, a, b), new_warm, warm)
-            return carry, _outputs(result)
-
+        _, warm0 = _first_state(p0, lubricant, s0, o0, fidelity)
         raw = run_continuation(
-            step,
+            _step,
             warm0,
             inputs,
+            args=shared,
             chunk_size=chunk_size,
             checkpoint_dir=checkpoint_dir,
             progress=progress,
@@ -256,6 +276,9 @@ def sweep(
         dte_rms=np.asarray(out["dte_rms"]),
         fixed_point_residual=np.asarray(out["fixed_point_residual"]),
         power_loss_position=np.asarray(out["power_loss_position"]),
+        tooth_force=np.asarray(out["tooth_force"]),
+        surface_velocity=np.asarray(out["surface_velocity"]),
+        hertz_pressure=np.asarray(out["hertz_pressure"]),
         status=status,
         messages=raw.messages,
     )

@@ -1,19 +1,26 @@
 """Physics-agnostic sweep engine: vmapped chunks, device sharding, checkpoint/resume, per-point status.
 
 ``run_points(point_fn, inputs, ...)`` evaluates ``point_fn`` on every row of a batch of inputs (a pytree
-of arrays with a leading axis N). Work is cut into chunks; each chunk is vmapped and jitted once (all
-chunks share one shape: the last one is padded), optionally sharded over devices along the batch axis
-with ``jax.sharding``, and, with a ``checkpoint_dir``, written to disk as soon as it finishes so an
-interrupted sweep resumes without recomputing finished chunks. A chunk that raises, or a point whose
+of arrays with a leading axis N), optionally with unbatched ``args`` shared by all points. Work is cut
+into chunks; each chunk is vmapped and jitted once (all chunks share one shape: the last one is padded),
+optionally sharded over devices along the batch axis with ``jax.sharding``, and, with a
+``checkpoint_dir``, written to disk as soon as it finishes so an interrupted sweep resumes without
+recomputing finished chunks. A chunk that raises, or a point whose
 outputs are not finite, is marked failed in the per-point status while every good point is kept.
 
 ``run_continuation(step_fn, carry0, inputs, ...)`` does the same for sequential sweeps (``lax.scan``
 carrying a state from point to point, e.g. the dynamic state across speeds), with the carry saved
 with each chunk.
+
+With ``args``, the point (step) function takes them as its last argument instead of closing over them,
+and its compiled chunk is kept per function: a second sweep with the same function and shapes (another
+torque, lubricant, surface finish...) reuses it instead of compiling again. The checkpoint fingerprint
+covers ``args`` too, so a resumed sweep never picks up chunks computed for other shared inputs.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import sys
@@ -89,7 +96,9 @@ def _slice(tree, lo, hi, pad_to=None):
 
 def _fingerprint(inputs, extra: str) -> str:
     h = hashlib.sha256(extra.encode())
-    for leaf in jax.tree_util.tree_leaves(inputs):
+    arrays, static = eqx.partition(inputs, eqx.is_array_like)
+    h.update(repr(jax.tree_util.tree_structure(arrays)).encode() + repr(static).encode())
+    for leaf in jax.tree_util.tree_leaves(arrays):
         arr = np.ascontiguousarray(np.asarray(leaf))
         h.update(str(arr.dtype).encode() + str(arr.shape).encode())
         h.update(arr.tobytes())
@@ -204,10 +213,26 @@ def _nan_like(shape_dtype_tree, n):
     return jax.tree_util.tree_map(fill, shape_dtype_tree)
 
 
+@functools.lru_cache(maxsize=32)
+def _batched_with_args(point_fn):
+    """One compiled-function cache per point function, shared by every sweep that uses it."""
+    return eqx.filter_jit(eqx.filter_vmap(point_fn, in_axes=(0, None)))
+
+
+@functools.lru_cache(maxsize=32)
+def _scan_with_args(step_fn):
+    @eqx.filter_jit
+    def scan_chunk(carry, xs, args):
+        return jax.lax.scan(lambda c, x: step_fn(c, x, args), carry, xs)
+
+    return scan_chunk
+
+
 def run_points(
-    point_fn: Callable[[Any], Any],
+    point_fn: Callable[..., Any],
     inputs: Any,
     *,
+    args: Any = None,
     chunk_size: int | None = None,
     checkpoint_dir: str | Path | None = None,
     progress: bool = False,
@@ -218,9 +243,12 @@ def run_points(
     """Evaluate ``point_fn`` (one point → pytree of arrays) on every row of ``inputs``.
 
     Args:
-        point_fn: pure, jit-able function of one point's inputs. If it returns a dict with a boolean
-            ``converged_key`` entry, points where it is False get status NOT_CONVERGED.
+        point_fn: pure, jit-able function of one point's inputs (and of ``args`` if given:
+            ``point_fn(point, args)``). If it returns a dict with a boolean ``converged_key`` entry,
+            points where it is False get status NOT_CONVERGED.
         inputs: pytree of arrays with leading axis N.
+        args: pytree shared by all points (not batched; non-array leaves are static). Give it, with a
+            module-level ``point_fn``, so later sweeps reuse the compiled chunk.
         chunk_size: points per chunk (default: all in one chunk, rounded up to the device count).
         checkpoint_dir: where finished chunks go; a rerun with the same inputs resumes from them.
         progress: print a progress bar on stderr.
@@ -232,11 +260,15 @@ def run_points(
     chunk = chunk_size or n
     chunk = -(-chunk // n_dev) * n_dev
     sharding, _ = _batch_sharding(devices, chunk)
-    fingerprint = _fingerprint(inputs, f"{label}:{chunk}")
+    fingerprint = _fingerprint((inputs, args), f"{label}:{chunk}")
     ckpt = _prepare_dir(checkpoint_dir, fingerprint)
-    batched = jax.jit(jax.vmap(point_fn))
+    if args is None:
+        batched = jax.jit(jax.vmap(point_fn))
+    else:
+        compiled = _batched_with_args(point_fn)
+        batched = lambda xs: compiled(xs, args)
     example = _slice(inputs, 0, 1, pad_to=chunk)
-    out_struct = jax.eval_shape(batched, example)
+    out_struct = eqx.filter_eval_shape(batched, example)
     treedef = jax.tree_util.tree_structure(out_struct)
     pieces, statuses, messages = [], [], []
     bar = _Progress(n, label, progress)
@@ -246,11 +278,11 @@ def run_points(
         if loaded is not None:
             out, status, _ = loaded
         else:
-            args = _slice(inputs, lo, hi, pad_to=chunk)
+            xs = _slice(inputs, lo, hi, pad_to=chunk)
             if sharding is not None:
-                args = jax.device_put(args, sharding)
+                xs = jax.device_put(xs, sharding)
             try:
-                out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(batched(args)))
+                out = jax.tree_util.tree_map(np.asarray, jax.block_until_ready(batched(xs)))
                 out = _slice(out, 0, hi - lo)
                 status = _status_from(out, hi - lo, converged_key)
             except Exception as err:  # noqa: BLE001 - keep every good point, report this chunk
@@ -267,10 +299,11 @@ def run_points(
 
 
 def run_continuation(
-    step_fn: Callable[[Any, Any], tuple[Any, Any]],
+    step_fn: Callable[..., tuple[Any, Any]],
     carry0: Any,
     inputs: Any,
     *,
+    args: Any = None,
     chunk_size: int | None = None,
     checkpoint_dir: str | Path | None = None,
     progress: bool = False,
@@ -279,20 +312,28 @@ def run_continuation(
 ) -> SweepOutput:
     """Sequential sweep: ``lax.scan(step_fn, carry, inputs)`` cut into chunks, with the carry stored
     with each finished chunk so an interrupted sweep resumes where it stopped. A chunk that raises
-    ends the sweep there: the points before it are kept, the rest are marked FAILED."""
+    ends the sweep there: the points before it are kept, the rest are marked FAILED.
+
+    With ``args`` the step is ``step_fn(carry, point, args)`` (see ``run_points``)."""
     n = _n_points(inputs)
     chunk = chunk_size or n
-    fingerprint = _fingerprint((carry0, inputs), f"{label}:{chunk}")
+    fingerprint = _fingerprint((carry0, inputs, args), f"{label}:{chunk}")
     ckpt = _prepare_dir(checkpoint_dir, fingerprint)
 
-    @jax.jit
-    def scan_chunk(carry, xs):
-        return jax.lax.scan(step_fn, carry, xs)
+    if args is None:
+
+        @jax.jit
+        def scan_chunk(carry, xs):
+            return jax.lax.scan(step_fn, carry, xs)
+
+    else:
+        compiled = _scan_with_args(step_fn)
+        scan_chunk = lambda carry, xs: compiled(carry, xs, args)
 
     carry = carry0
     carry_treedef = jax.tree_util.tree_structure(carry0)
     first = _slice(inputs, 0, min(chunk, n), pad_to=chunk)
-    out_struct = jax.eval_shape(scan_chunk, carry0, first)[1]
+    out_struct = eqx.filter_eval_shape(scan_chunk, carry0, first)[1]
     treedef = jax.tree_util.tree_structure(out_struct)
     pieces, statuses, messages = [], [], []
     bar = _Progress(n, label, progress)
@@ -301,7 +342,7 @@ def run_continuation(
         hi = min(lo + chunk, n)
         loaded = None if broken else _load(ckpt, index, treedef, carry_treedef)
         if broken:
-            struct = jax.eval_shape(scan_chunk, carry0, _slice(inputs, lo, hi))[1]
+            struct = eqx.filter_eval_shape(scan_chunk, carry0, _slice(inputs, lo, hi))[1]
             out, status = _nan_like(struct, hi - lo), np.full(hi - lo, FAILED, dtype=np.int32)
         elif loaded is not None:
             out, status, carry = loaded
@@ -316,7 +357,7 @@ def run_continuation(
                 _store(ckpt, index, out, status, carry)
             except Exception as err:  # noqa: BLE001
                 messages.append(f"points {lo}-{hi - 1}: {type(err).__name__}: {err}")
-                struct = jax.eval_shape(scan_chunk, carry0, _slice(inputs, lo, hi))[1]
+                struct = eqx.filter_eval_shape(scan_chunk, carry0, _slice(inputs, lo, hi))[1]
                 out, status = _nan_like(struct, hi - lo), np.full(hi - lo, FAILED, dtype=np.int32)
                 broken = True
         pieces.append(out)

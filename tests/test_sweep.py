@@ -76,6 +76,39 @@ def test_resume_after_interruption(base, tmp_path):
     assert len(sorted(tmp_path.glob("chunk_*.npz"))) == 3
 
 
+def test_checkpoint_belongs_to_its_base_point(base, tmp_path):
+    # Same speeds, same checkpoint directory, another torque: the finished chunks of the first sweep
+    # must not be taken for the second (they once were: the fingerprint covered the speeds only).
+    pair, lub, surf, _ = base
+    speeds = np.array([600.0, 1700.0, 2900.0])
+    loss = {
+        torque: sweep(
+            pair,
+            lub,
+            surf,
+            jg.OperatingPoint(torque, 1000.0),
+            speeds_rpm=speeds,
+            fidelity=FID,
+            chunk_size=3,
+            checkpoint_dir=tmp_path,
+        ).power_loss
+        for torque in (700.0, 1500.0)
+    }
+    fresh = sweep(
+        pair, lub, surf, jg.OperatingPoint(1500.0, 1000.0), speeds_rpm=speeds, fidelity=FID
+    )
+    np.testing.assert_allclose(loss[1500.0], fresh.power_loss, rtol=1e-12)
+    assert np.all(loss[1500.0] > 1.5 * loss[700.0])
+
+
+def test_per_position_outputs_match_simulate(base):
+    pair, lub, surf, op = base
+    res = sweep(pair, lub, surf, op, speeds_rpm=[600.0, 1700.0, 2900.0], fidelity=FID, chunk_size=3)
+    one = simulate(pair, lub, surf, jg.OperatingPoint(700.0, 1700.0), FID)
+    for name in ("power_loss_position", "tooth_force", "surface_velocity", "hertz_pressure"):
+        np.testing.assert_allclose(getattr(res, name)[1], getattr(one, name), rtol=1e-12)
+
+
 def test_sharded_sweep_equals_single_device(tmp_path):
     script = textwrap.dedent(
         """

@@ -190,6 +190,46 @@ def test_continuation_failing_chunk_keeps_earlier_points_and_resumes(tmp_path):
     expected[6:] = expected[5] + np.cumsum(xs[6:] + 1000.0)
     np.testing.assert_allclose(again.outputs["cum"], expected)
     np.testing.assert_array_equal(again.status, OK)
+TRACES = []
+
+
+def scaled(inp, args):
+    TRACES.append(1)  # runs once per trace, not per call
+    return {"y": inp["x"] * args["a"]}
+
+
+def scaled_step(carry, inp, args):
+    TRACES.append(1)
+    new = carry + inp["x"] * args["a"]
+    return new, {"cum": new}
+
+
+def test_shared_args_reuse_the_compiled_chunk_and_enter_the_fingerprint(tmp_path):
+    xs = np.arange(6.0)
+    TRACES.clear()
+    one = run_points(
+        scaled, {"x": xs}, args={"a": jnp.asarray(2.0)}, chunk_size=3, converged_key=None
+    )
+    two = run_points(
+        scaled, {"x": xs}, args={"a": jnp.asarray(3.0)}, chunk_size=3, converged_key=None
+    )
+    np.testing.assert_array_equal(one.outputs["y"], 2 * xs)
+    np.testing.assert_array_equal(two.outputs["y"], 3 * xs)
+    assert len(TRACES) == 1  # the second sweep reused the first one's compiled chunk
+    TRACES.clear()
+    cum = lambda a: run_continuation(
+        scaled_step,
+        jnp.zeros(()),
+        {"x": xs},
+        args={"a": jnp.asarray(a)},
+        chunk_size=4,
+        checkpoint_dir=tmp_path,
+        converged_key=None,
+    )
+    np.testing.assert_allclose(cum(2.0).outputs["cum"], np.cumsum(2 * xs))
+    # Same points, other shared inputs, same checkpoint directory: nothing stale is reused.
+    np.testing.assert_allclose(cum(5.0).outputs["cum"], np.cumsum(5 * xs))
+    assert len(TRACES) == 1
 
 
 def test_sharded_over_two_host_devices_equals_single_device(tmp_path):

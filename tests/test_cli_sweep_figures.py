@@ -1,0 +1,236 @@
+"""`jaxgear sweep --config` and `jaxgear figures`: files written, bad config → exit 2 naming the key,
+figures skipped with a reason where the fidelity cannot give them, the R1-R11 table complete.
+
+Cost: the default tests run the quasi-static rung (one cheap compile each); the tribo-dynamic
+`figures --quick` and the EHL contact fields are `slow` (a tribo-dynamic compile is 1-3 min here).
+"""
+
+import dataclasses
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import jaxgear as jg
+from jaxgear.cli import main
+from jaxgear.config import load_toml, sweep_from_config
+from jaxgear.fidelity import Fidelity
+
+ROOT = Path(__file__).resolve().parents[1]
+TINY = """
+[gear]
+preset = "li2015_calibrated"
+[operating]
+torque_Nm = 700.0
+inlet_temperature_C = 90.0
+[fidelity]
+preset = "fast"
+dynamics = "quasi_static"
+n_positions = 24
+[sweep]
+speeds_rpm = [1000.0, 2000.0, 3000.0]
+chunk_size = 3
+progress = false
+[sweep.vary]
+torque_Nm = [700.0, 700.0, 1500.0]
+"""
+R_IDS = [f"R{i}" for i in range(1, 12)]
+
+
+def _toml(tmp_path, text, name="c.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_sweep_from_tiny_toml_writes_files(tmp_path, capsys):
+    out = tmp_path / "out"
+    args = ["sweep", "--config", str(_toml(tmp_path, TINY)), "--out", str(out), "--no-progress"]
+    assert main(args) == 0
+    for name in ("sweep.csv", "summary.json", "dte_rms.png", "power_loss.png", "efficiency.png"):
+        assert (out / name).stat().st_size > 200, name
+    assert not (out / "sweep_quasi_static.csv").exists()  # the sweep is quasi-static itself
+    rows = (out / "sweep.csv").read_text().splitlines()
+    assert rows[0].startswith("speed_rpm,torque,power_loss_W") and len(rows) == 4
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["headline"]["points"] == 3 and summary["headline"]["points_not_converged"] == 0
+    assert summary["inputs"]["sweep"]["vary"] == {"torque_Nm": [700.0, 700.0, 1500.0]}
+    assert summary["fidelity"]["n_positions"] == 24
+    loss = np.loadtxt(out / "sweep.csv", delimiter=",", skiprows=1, usecols=2)
+    # More speed, more sliding loss; 1500 N m at 3000 rpm well above 700 N m at 2000 rpm (R7 trend).
+    assert loss[2] > 2.0 * loss[1] > 2.0 * loss[0]
+    assert "wrote sweep.csv" in capsys.readouterr().out
+    # The same config again finds its finished chunks and reproduces the table exactly.
+    first = (out / "sweep.csv").read_text()
+    assert main(args) == 0
+    assert (out / "sweep.csv").read_text() == first
+
+
+def test_example_config_resolves():
+    cfg = sweep_from_config(load_toml(ROOT / "examples" / "sweep.toml"))
+    assert cfg.mode == "continuation" and cfg.quasi_static_reference
+    np.testing.assert_array_equal(cfg.speeds, np.arange(1000.0, 4001.0, 250.0))
+    assert cfg.fidelity == Fidelity.fast(n_positions=32)
+    # The example's pair is the calibrated preset of `jaxgear run`.
+    calibrated = jg.presets.li2015_pair_calibrated()
+    np.testing.assert_allclose(cfg.pair.blank_mass, calibrated.blank_mass)
+    np.testing.assert_allclose(cfg.pair.tip_relief.amount, calibrated.tip_relief.amount)
+    paper = sweep_from_config(load_toml(ROOT / "examples" / "sweep.toml"), fidelity="paper")
+    assert paper.fidelity == Fidelity.paper(n_positions=32)
+
+
+SPEEDS = "[sweep]\nspeeds_rpm = [1000.0]\n"
+BAD = [
+    ("[sweep]\nspeeds_rpm = [1000.0]\nbogus = 1\n", "unknown key sweep.bogus"),
+    ("[extra]\na = 1\n" + SPEEDS, "unknown table [extra]"),
+    (
+        "[sweep]\nspeeds_rpm = [1000.0, -5.0]\n",
+        "sweep.speeds_rpm = [1000.   -5.] rpm is out of range",
+    ),
+    ("[sweep]\nspeed_range_rpm = [4200, 500, 25]\n", "sweep.speed_range_rpm = [4200, 500, 25]"),
+    ("[sweep]\nmode = 'parallel'\n", "needs exactly one of speeds_rpm"),
+    (SPEEDS + "mode = 'serial'\n", "sweep.mode = 'serial' is not valid"),
+    (SPEEDS + "chunk_size = 2.5\n", "sweep.chunk_size = 2.5 has the wrong type; expected integer"),
+    (SPEEDS + "chunk_size = 0\n", "sweep.chunk_size = 0 is out of range"),
+    ("[fidelity]\nn_positions = 10\n" + SPEEDS, "fidelity.n_positions = 10 is out of range"),
+    ("[fidelity]\nthermal = 'yes'\n" + SPEEDS, "fidelity.thermal = 'yes' has the wrong type"),
+    ("[fidelity]\npreset = 'exact'\n" + SPEEDS, "fidelity preset = 'exact' is not valid"),
+    ("[lubricant]\npreset = 'castor'\n" + SPEEDS, "lubricant.preset = 'castor' is not valid"),
+    ("[lubricant]\neyring_stress = -1.0\n" + SPEEDS, "lubricant.eyring_stress = -1 Pa is out"),
+    ("[surfaces]\npreset = 'sandblasted'\n" + SPEEDS, "surfaces.preset = 'sandblasted'"),
+    ("[surfaces]\nscale = -1.0\n" + SPEEDS, "surfaces.scale = -1 is out of range"),
+    ("[operating]\ntorque_Nm = -700\n" + SPEEDS, "operating.torque_Nm = -700 N m is out of range"),
+    ("[operating]\nspeed_rpm = 1000.0\n" + SPEEDS, "operating.speed_rpm is not used"),
+    ("[operating]\ninlet_temperature_C = 900\n" + SPEEDS, "operating.inlet_temperature_C = 900"),
+    ("[gear]\nmodule_mm = '3'\n" + SPEEDS, "gear.module_mm = '3' has the wrong type"),
+    ("[gear]\npreset = 'li2016'\n" + SPEEDS, "gear.preset = 'li2016' is not valid"),
+    (
+        "[sweep]\nspeeds_rpm = [1000.0, 2000.0]\n[sweep.vary]\ntorque_Nm = [1.0, 2.0, 3.0]\n",
+        "sweep.vary.torque_Nm has 3 values; valid: 1 or one per speed (2)",
+    ),
+    (SPEEDS + "[sweep.vary]\nmodule_mm = 3.0\n", "unknown key sweep.vary.module_mm"),
+    ("not toml = = 1\n", "is not valid TOML"),
+]
+
+
+@pytest.mark.parametrize("text, message", BAD, ids=[m[:40] for _, m in BAD])
+def test_sweep_bad_config_exit_2(tmp_path, capsys, text, message):
+    args = ["sweep", "--config", str(_toml(tmp_path, text)), "--out", str(tmp_path / "o")]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("jaxgear sweep: error: ") and message in err, err
+
+
+def test_sweep_bad_config_no_traceback(tmp_path):
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "jaxgear.cli",
+            "sweep",
+            "--config",
+            str(_toml(tmp_path, "[sweep]\nspeeds_rpm = [1000.0]\nbogus = 1\n")),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
+    assert proc.returncode == 2
+    assert "unknown key sweep.bogus" in proc.stderr and "Traceback" not in proc.stderr
+    missing = subprocess.run(
+        [sys.executable, "-m", "jaxgear.cli", "sweep", "--config", str(tmp_path / "nope.toml")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
+    assert missing.returncode == 2 and "does not exist" in missing.stderr
+
+
+def _check_figure_outputs(out, stdout, drawn, skipped):
+    manifest = json.loads((out / "figures.json").read_text())
+    for n in drawn:
+        name = manifest["written"][f"Fig. {n}"]
+        assert (out / name).stat().st_size > 5000, name
+        assert f"wrote Fig. {n}:" in stdout
+    for n in skipped:
+        reason = manifest["skipped"][f"Fig. {n}"]
+        assert len(reason) > 20
+        assert f"skipped Fig. {n}: {reason}" in stdout
+    assert set(manifest["written"]) | set(manifest["skipped"]) == {
+        f"Fig. {n}" for n in range(3, 13)
+    }
+    rows = json.loads((out / "paper_table.json").read_text())
+    assert [r["id"] for r in rows] == R_IDS
+    for r in rows:
+        assert r["paper"] and r["jaxgear"] and r["agrees"] in (True, False, None)
+        if r["agrees"] is None:
+            assert r["note"], r["id"]  # why it was not judged
+    md = (out / "paper_table.md").read_text()
+    assert all(f"| {i} |" in md for i in R_IDS)
+    for name in manifest["data"]:
+        assert len((out / name).read_text().splitlines()) == 8, name  # header + seven speeds
+    return manifest, {r["id"]: r for r in rows}
+
+
+def test_figures_quick_cli(tmp_path, capsys, monkeypatch):
+    # The command's plumbing at quasi-static cost: the preset is swapped for its quasi-static rung
+    # (the tribo-dynamic run is test_figures_quick_fast_fidelity below, slow).
+    named = Fidelity.named.__func__
+    monkeypatch.setattr(
+        Fidelity,
+        "named",
+        classmethod(lambda cls, name, **kw: named(cls, name, dynamics="quasi_static", **kw)),
+    )
+    out = tmp_path / "figs"
+    assert main(["figures", "--quick", "--out", str(out), "--no-progress"]) == 0
+    stdout = capsys.readouterr().out
+    manifest, rows = _check_figure_outputs(out, stdout, (3, 4, 5, 8, 10, 11), (6, 7, 9, 12))
+    assert "iso-thermal" in manifest["skipped"]["Fig. 6"]
+    assert "solves no EHL contact" in manifest["skipped"]["Fig. 7"]
+    assert manifest["points_source"] == "nominal" and manifest["quick"]
+    assert manifest["fidelity"]["n_positions"] == 24
+    # The fast rung's physics where it can judge: polished below ground, 1500 N m above 700 N m.
+    assert rows["R7"]["agrees"] is True and rows["R8"]["agrees"] is True
+    for rid in ("R5", "R9", "R10"):
+        assert rows[rid]["agrees"] is None
+    assert "temperature part not evaluated" in rows["R11"]["note"]
+
+
+@pytest.mark.slow
+def test_figures_quick_fast_fidelity(tmp_path, capsys):
+    out = tmp_path / "figs"
+    assert main(["figures", "--quick", "--out", str(out), "--no-progress"]) == 0
+    stdout = capsys.readouterr().out
+    manifest, rows = _check_figure_outputs(out, stdout, (3, 4, 5, 8, 10, 11), (6, 7, 9, 12))
+    assert manifest["fidelity"]["dynamics"] == "tribo_dynamic"
+    # Vibration matters near resonance: tribo-dynamic and quasi-static differ at point B.
+    assert "B nearly equal" not in rows["R3"]["jaxgear"]
+
+
+@pytest.mark.slow
+def test_contact_fields_on_an_ehl_rung():
+    # Figs. 7/12 and R11 from contact fields: the loads and velocities of a cheap quasi-static
+    # regression run, the contacts solved by smooth iso-thermal EHL (the fidelity's EHL model).
+    from jaxgear.figures import _contact_fields
+
+    repro = jg.figures.reproduce_paper(
+        Fidelity(dynamics="quasi_static"), quick=True, speeds_rpm=[1800.0, 3500.0]
+    )
+    ehl = Fidelity(dynamics="quasi_static", friction="ehl_smooth", n_positions=24, n_nodes=129)
+    repro = dataclasses.replace(repro, fidelity=ehl, fields={})
+    _contact_fields(repro)
+    for key in ("fig7_B", "fig7_E"):
+        f = repro.fields[key]
+        assert f.solution is not None and bool(f.solution.converged), key
+        assert abs(f.roll_angle_deg - 25.0) < 0.2
+        # The EHL pressure peak of a heavily loaded smooth contact is near the Hertz pressure.
+        assert 0.8 < float(f.solution.p_max) / f.hertz_pressure < 1.3
+    fig = jg.figures.figure(repro, 7)
+    assert len(fig.axes) == 4  # p and h at B and E; no temperature row (iso-thermal)
+    with pytest.raises(jg.figures.FigureUnavailable, match="mixed EHL rung"):
+        jg.figures.figure(repro, 12)
