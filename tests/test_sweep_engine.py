@@ -190,6 +190,8 @@ def test_continuation_failing_chunk_keeps_earlier_points_and_resumes(tmp_path):
     expected[6:] = expected[5] + np.cumsum(xs[6:] + 1000.0)
     np.testing.assert_allclose(again.outputs["cum"], expected)
     np.testing.assert_array_equal(again.status, OK)
+
+
 TRACES = []
 
 
