@@ -36,6 +36,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--steps", type=int, default=40, help="passage steps timed")
+    ap.add_argument("--nodes", type=int, nargs="+", default=[257, 513], help="grid sizes")
     args = ap.parse_args(argv)
     surf = jg.presets.ground()
     rows = []
@@ -46,7 +47,7 @@ def main(argv=None):
         ("statistical mixed, thermal", dict(mixed="statistical", thermal=True), surf),
         ("deterministic mixed, iso-thermal", dict(mixed="deterministic"), surf),
     ]
-    for n in (257, 513):
+    for n in args.nodes:
         for label, kw, s in cases:
             model = jg.EHLModel(n_nodes=n, **kw)
             for rpm in (500.0, 3500.0):
