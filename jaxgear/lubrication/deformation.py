@@ -65,6 +65,17 @@ def influence_vector(n: int, spacing, pad: int = 0):
     return -(spacing / jnp.pi) * (jnp.asarray(full) + jnp.log(spacing))
 
 
+def influence_rows(n: int, spacing, before: int = 0, after: int = 0):
+    """Rows i = −before … n − 1 + after of the Toeplitz influence matrix (D[i, j] = d(i − j), j =
+    0 … n − 1), shape (n + before + after, n): the rows outside 0 … n − 1 are those of the same
+    kernel continued past the grid (what a shifted stencil reads)."""
+    pad = max(before, after)
+    d = influence_vector(n, spacing, pad=pad)  # d(m), m = −(n − 1 + pad) … n − 1 + pad
+    i = jnp.arange(-before, n + after)
+    j = jnp.arange(n)
+    return d[(i[:, None] - j[None, :]) + (n - 1 + pad)]
+
+
 def deformation_dense(pressure, spacing):
     """V = D @ P with the dense influence matrix (Hertz-scaled)."""
     return influence_matrix(pressure.shape[-1], spacing) @ pressure

@@ -32,12 +32,14 @@ import functools
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import jax.scipy.linalg
 import numpy as np
 from jaxtyping import Array, Bool, Float, Int
 
 from .._validation import (
     check_choice,
     check_finite,
+    check_integer,
     check_positive,
     check_range,
     is_concrete,
@@ -215,10 +217,13 @@ class EHLModel(eqx.Module):
         check_range("EHLModel.asperity_relaxation", self.asperity_relaxation, 0.01, 1.0)
         check_range("EHLModel.fb_smoothing", self.fb_smoothing, 0.0, 1e-2, low_inclusive=False)
         check_range("EHLModel.tolerance", self.tolerance, 0.0, 1e-2, low_inclusive=False)
-        if not isinstance(self.thermal, bool):
-            raise ValueError(
-                f"EHLModel.thermal = {self.thermal!r} is not valid; valid: True, False"
-            )
+        for name in ("thermal", "auto_domain"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(
+                    f"EHLModel.{name} = {getattr(self, name)!r} is not valid; valid: True, False"
+                )
+        # the coarsest grid of the sequence (a larger value than n_nodes means a single grid)
+        check_integer("EHLModel.coarsest_nodes", self.coarsest_nodes, 17)
         check_range("EHLModel.boundary_friction", self.boundary_friction, 0.0, 1.0)
         check_range(
             "EHLModel.contact_threshold", self.contact_threshold, 1e-4, 0.1, low_inclusive=True
@@ -272,7 +277,8 @@ class EHLSolution(eqx.Module):
         contact_fraction: share of the Hertz zone |x| ≤ b in asperity contact.
         contact_load: ∫ p dx over contact nodes, N/m (``contact_load_share``: its share).
         load_error: (∫ p dx − w')/w'.
-        hertz_half_width (m), hertz_pressure (Pa), moes_m, moes_l: scales of the contact.
+        hertz_half_width (m), hertz_pressure (Pa), moes_m, moes_l: scales of the contact;
+            moes_film: Moes' central-film estimate for them, m (the reference a warm start scales).
         converged, residual (‖F‖∞ of the fine-grid system), iterations (Newton, all levels).
         thermal_residual: largest change of the film temperature in the last thermal (Picard)
             iteration, K (0 isothermal).
@@ -313,6 +319,7 @@ class EHLSolution(eqx.Module):
     hertz_pressure: Float[Array, ""]
     moes_m: Float[Array, ""]
     moes_l: Float[Array, ""]
+    moes_film: Float[Array, ""]
     converged: Bool[Array, ""]
     residual: Float[Array, ""]
     iterations: Int[Array, ""]
@@ -460,7 +467,7 @@ class _Level(eqx.Module):
     sc: _Scales
     x: Array
     spacing: Array
-    kernel: Array  # dense influence matrix (n, n)
+    kernel_rows: Array  # influence matrix rows i = −2 … n (n + 3, n): D[i, j] = d(i − j)
     temperature: Array
     log_eta0_nodes: Array  # ln η0(T) at the nodes (ambient pressure), η in Pa s
     alpha_nodes: Array  # α(T) at the nodes, 1/Pa
@@ -476,7 +483,7 @@ class _Level(eqx.Module):
     def deformation(self, p):
         if self.model.use_fft(self.n):
             return deformation_mod.deformation_fft(p, self.spacing)
-        return self.kernel @ p
+        return self.kernel_rows[2 : self.n + 2] @ p
 
     def film(self, u):
         p, h0 = u[: self.n], u[self.n]
@@ -537,13 +544,14 @@ class _Level(eqx.Module):
             valid = (col >= 0) & (col < n)
             dps.append(jnp.where(valid, jp[col % 4, rows], 0.0))
             dhs.append(jnp.where(valid, jh[col % 4, rows], 0.0))
-        # J[i, j] = Σ_k dP_k[i] [j = i + k] + Σ_k dH_k[i] D[i + k, j], with the Toeplitz influence
-        # matrix D[i, j] = d(i − j) read from a padded 1-D kernel: one fused pass over n² entries.
-        kern = deformation_mod.influence_vector(n, self.spacing, pad=2)  # d(m), m = −(n+1) … n+1
+        # J[i, j] = Σ_k dP_k[i] [j = i + k] + Σ_k dH_k[i] D[i + k, j]: the shifted influence rows
+        # are slices of the level's padded matrix (built once per solve, outside the Newton loop),
+        # so the assembly is one fused elementwise pass over n² entries, with no gathers
         m = rows[:, None] - rows[None, :]
         dense = jnp.zeros((n, n), dtype=p.dtype)
         for k, dp, dh in zip(offsets, dps, dhs, strict=True):
-            dense = dense + dh[:, None] * kern[m + k + n + 1] + jnp.where(m == -k, dp[:, None], 0.0)
+            shifted = self.kernel_rows[k + 2 : k + 2 + n]
+            dense = dense + dh[:, None] * shifted + jnp.where(m == -k, dp[:, None], 0.0)
         h0_col = sum(dhs)
         top = jnp.concatenate([dense, h0_col[:, None]], axis=1)
         bottom = jnp.concatenate(
@@ -555,7 +563,7 @@ class _Level(eqx.Module):
 
 def _make_level(model: EHLModel, inp: _Inputs, sc: _Scales, n: int, fine_n: int) -> _Level:
     x, spacing = _grid(sc, n)
-    kernel = deformation_mod.influence_matrix(n, spacing)
+    kernel = deformation_mod.influence_rows(n, spacing, before=2, after=1)
     r = inp.contact.reduced_radius
     h_scale = sc.b**2 / r
     if n == fine_n:
@@ -586,9 +594,39 @@ def _norm_inf(f):
     return jnp.max(jnp.abs(f))
 
 
-def _newton(level: _Level, u0, s, max_iter: int):
-    """Damped Newton on level's system. Returns (u, ‖F‖∞, iterations, converged)."""
-    tol = level.model.tolerance
+_MIXED_PRECISION_NODES = 513  # from this size on, the LU of the Newton matrix is single precision
+_DIRECTION_TOLERANCE = 1e-3  # accepted relative residual ‖J d + F‖/‖F‖ of a mixed-precision step
+
+
+def _newton_direction(jac, f):
+    """Newton direction d = −J⁻¹F.
+
+    On large grids the dense LU dominates the cost (≈ 30 ms at N = 1025); there it is factorised in
+    single precision (half the time) and the direction refined twice against the float64 matrix
+    (cond J ≈ 1e6 at high load: each refinement gains ~cond·ε32 ≈ 0.1). A direction still off by
+    more than ``_DIRECTION_TOLERANCE`` is recomputed in double precision. The convergence test
+    stays on the float64 residual, so only the path to the solution changes, not the solution."""
+    n = jac.shape[0]
+    if n < _MIXED_PRECISION_NODES:
+        return jnp.linalg.solve(jac, -f)
+    lu = jax.scipy.linalg.lu_factor(jac.astype(jnp.float32))
+
+    def solve32(r):
+        return jax.scipy.linalg.lu_solve(lu, r.astype(jnp.float32)).astype(jac.dtype)
+
+    d = solve32(-f)
+    for _ in range(2):
+        d = d + solve32(-f - jac @ d)
+    bad = ~(
+        jnp.linalg.norm(jac @ d + f) <= _DIRECTION_TOLERANCE * jnp.linalg.norm(f)
+    )  # NaN-safe: a non-finite direction is bad
+    return jax.lax.cond(bad, lambda: jnp.linalg.solve(jac, -f), lambda: d)
+
+
+def _newton(level: _Level, u0, s, max_iter: int, tol=None):
+    """Damped Newton on level's system to ‖F‖∞ < ``tol`` (default: the model's tolerance).
+    Returns (u, ‖F‖∞, iterations, converged)."""
+    tol = level.model.tolerance if tol is None else tol
 
     def merit(u):
         f = level.residual(u, s)
@@ -604,7 +642,7 @@ def _newton(level: _Level, u0, s, max_iter: int):
     def body(state):
         u, f, m, it, _ = state
         jac = level.jacobian(u, s)
-        d = jnp.linalg.solve(jac, -f)
+        d = _newton_direction(jac, f)
         d = jnp.where(jnp.isfinite(d), d, 0.0)
         # cap the film-offset change per step: a runaway H0 is the usual way a far start diverges
         cap = 0.5 * jnp.maximum(jnp.abs(u[-1]), 10.0 * level.sc.h_ref)
@@ -641,7 +679,10 @@ def _newton(level: _Level, u0, s, max_iter: int):
 
 
 def _hertz_start(level: _Level):
-    p = jnp.sqrt(jnp.maximum(1.0 - level.x**2, 0.0))
+    # the Hertz ellipse, widened to span at least two cells: on the wide domain of a thick film
+    # (M ≪ 1) a coarse grid may hold no node inside |X| < 1, and the normalisation would be 0/0
+    half = jnp.maximum(1.0, 2.0 * level.spacing)
+    p = jnp.sqrt(jnp.maximum(1.0 - (level.x / half) ** 2, 0.0))
     p = p * (0.5 * jnp.pi) / (level.spacing * jnp.sum(p))
     defo = level.deformation(p)
     # film offset such that the central film equals the Moes estimate
@@ -650,12 +691,26 @@ def _hertz_start(level: _Level):
 
 
 def _transfer(coarse: _Level, fine: _Level, u):
-    p = jnp.interp(fine.x, coarse.x, u[: coarse.n])
+    pc = u[: coarse.n]
+    if fine.n == 2 * coarse.n - 1:
+        # the grid sequence halves Δ: coarse nodes are every other fine node; the midpoints by
+        # 4-point cubic interpolation, clipped at zero (saves 1-2 fine-grid Newton iterations over
+        # linear interpolation: the fine-grid LU is the dominant cost)
+        before = jnp.concatenate([pc[:1], pc[:-2]])
+        after = jnp.concatenate([pc[2:], pc[-1:]])
+        mid = jnp.maximum((9.0 * (pc[:-1] + pc[1:]) - before - after) / 16.0, 0.0)
+        p = jnp.zeros((fine.n,), dtype=pc.dtype).at[::2].set(pc).at[1::2].set(mid)
+    else:
+        p = jnp.interp(fine.x, coarse.x, pc)
     p = p.at[0].set(0.0).at[-1].set(0.0)
     # keep the central film across the transfer (H0 absorbs the O(Δ) change of the discrete kernel)
     hc = jnp.interp(0.0, coarse.x, coarse.film(u))
-    h0 = hc - jnp.interp(0.0, fine.x, fine.deformation(p) + fine.offset)
-    return jnp.concatenate([p, h0[None]])
+    return jnp.concatenate([p, _offset_for_central_film(fine, p, hc)[None]])
+
+
+def _offset_for_central_film(level: _Level, p, hc):
+    """H0 that puts the central film H(0) at ``hc`` for pressure P on ``level``."""
+    return hc - jnp.interp(0.0, level.x, level.deformation(p + level.asperity) + level.offset)
 
 
 def _schedules(model: EHLModel, dtype):
@@ -667,6 +722,9 @@ def _schedules(model: EHLModel, dtype):
     k = model.continuation_steps
     i = np.arange(1, k + 1)
     return jnp.asarray(np.stack([np.ceil(4.0 * i / k) / 4.0, i / k]), dtype=dtype)
+
+
+_INTERMEDIATE_TOLERANCE = 1e-6
 
 
 def _cold_start(model: EHLModel, levels: list[_Level], svals):
@@ -688,9 +746,12 @@ def _cold_start(model: EHLModel, levels: list[_Level], svals):
     (u, iters), _ = jax.lax.scan(cont, (u, jnp.asarray(0)), svals)
     if len(levels) == 1:
         return u, iters
+    # intermediate grids only supply the next start: their own discretisation error (O(Δ²) ≈ 1e-3)
+    # dwarfs any residual below _INTERMEDIATE_TOLERANCE, so iterating further buys nothing
+    tol = max(model.tolerance, _INTERMEDIATE_TOLERANCE)
     for prev, lev in zip(levels[:-2], levels[1:-1], strict=False):
         u = _transfer(prev, lev, u)
-        u, _, k, _ = _newton(lev, u, 1.0, model.max_iterations)
+        u, _, k, _ = _newton(lev, u, 1.0, model.max_iterations, tol)
         iters = iters + k
     return _transfer(levels[-2], levels[-1], u), iters
 
@@ -711,11 +772,26 @@ def _fine_level(model: EHLModel, inp: _Inputs):
 
 
 def _warm_start(fine: _Level, init_x, init_p, init_h0):
-    sc = fine.sc
-    p = jnp.interp(fine.x * sc.b, init_x, init_p, left=0.0, right=0.0) / sc.ph
+    """Start from a solution of a nearby contact in Hertz-scaled variables (``_warm_args``): its
+    P(X) on this grid, and its central film scaled by the ratio of the two Moes estimates. For the
+    neighbouring mesh position this halves the Newton iterations of a start in physical variables
+    (whose load and cavitation point are off by the change of b and ph)."""
+    p = jnp.interp(fine.x, init_x, init_p, left=0.0, right=0.0)
     p = p.at[0].set(0.0).at[-1].set(0.0)
-    h0 = init_h0 * fine.inp.contact.reduced_radius / sc.b**2
-    return jnp.concatenate([p, h0[None]])
+    hc = init_h0 * fine.sc.h_ref
+    return jnp.concatenate([p, _offset_for_central_film(fine, p, hc)[None]])
+
+
+def _warm_args(sol: EHLSolution):
+    """(X, P, H_c/H_Moes) of a solution: what ``_warm_start`` reads. Guarded so that a failed or
+    placeholder solution gives a harmless start (the cold fallback follows if it does not
+    converge)."""
+    b = jnp.where(sol.hertz_half_width > 0.0, sol.hertz_half_width, 1.0)
+    ph = jnp.where(sol.hertz_pressure > 0.0, sol.hertz_pressure, 1.0)
+    ratio = sol.h_central / jnp.where(sol.moes_film > 0.0, sol.moes_film, jnp.inf)
+    ratio = jnp.where(jnp.isfinite(ratio) & (ratio > 0.0), jnp.clip(ratio, 0.05, 20.0), 1.0)
+    p = jnp.where(jnp.isfinite(sol.fluid_pressure), sol.fluid_pressure, 0.0)
+    return sol.x / b, p / ph, ratio
 
 
 @functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2))
@@ -867,7 +943,9 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     h_min = jnp.where(curv > 0, h_0 - (hp - hm) ** 2 / (8.0 * safe), h_0) * h_scale
     h_central = jnp.interp(0.0, lev.x, big_h) * h_scale
     load_err = jnp.sum(weights * (p_dim + p_asp)) / c.load_per_width - 1.0
-    hertz_zone = (jnp.abs(lev.x) <= 1.0).astype(p_dim.dtype)
+    # nodes of the Hertz zone (at least the one nearest the centre: a coarse grid on a wide domain
+    # may have no node inside |X| ≤ 1)
+    hertz_zone = (jnp.abs(lev.x) <= jnp.maximum(1.0, 0.5 * lev.spacing)).astype(p_dim.dtype)
     p_loss_slide = jnp.sum(weights * q_slide)
     p_loss_asp = jnp.sum(weights * q_asp)
     p_loss_roll = jnp.sum(q_roll_face) * dx
@@ -915,6 +993,7 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
         hertz_pressure=sc.ph,
         moes_m=sc.moes_m,
         moes_l=sc.moes_l,
+        moes_film=sc.h_ref * h_scale,
         converged=ok > 0.5,
         residual=res,
         iterations=jax.lax.stop_gradient(it).astype(jnp.int32),
@@ -987,33 +1066,57 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
             model.asperity_slope_ratio,
         )
 
-    # Outer (Picard) iteration: Reynolds at fixed temperatures and asperity pressures (Newton, warm
-    # started), then the temperatures of its heat source and the asperity pressure of its film.
-    def picard(carry, _):
-        sol, inp_k, _ = carry
-        changes = []
-        inp_next = inp_k
+    def thermal_settled(change, rise):
+        # the film temperature moved by < 1 % of its largest rise (or < 0.05 K)
+        return change <= jnp.maximum(0.01 * jnp.max(jnp.abs(rise)), 0.05)
+
+    def updates(sol, inp_k):
+        """The inputs the solution ``sol`` implies (temperatures, relaxed asperity pressure) and
+        whether they agree with those it was solved with (then the outer iteration has
+        converged)."""
+        inp_next, settled = inp_k, jnp.asarray(True)
         if model.thermal:
             temps = _temperatures(inp_k, sol, solids, transient)
             rise = _safe_rise(temps.film_mean)
+            change = jnp.max(jnp.abs(rise - inp_k.temperature_rise))
+            settled = settled & thermal_settled(change, rise)
             inp_next = eqx.tree_at(lambda i: i.temperature_rise, inp_next, rise)
         if statistical:
             beta = model.asperity_relaxation
             target = jnp.where(jnp.isfinite(sol.h), asperity_of(sol), 0.0)
             target = jnp.minimum(target, 20.0 * ph)
+            settled = settled & (jnp.max(jnp.abs(target - inp_k.asperity_pressure)) <= 1e-3 * ph)
             pa = (1.0 - beta) * inp_k.asperity_pressure + beta * target
-            changes.append(jnp.max(jnp.abs(target - inp_k.asperity_pressure)) / ph)
             inp_next = eqx.tree_at(lambda i: i.asperity_pressure, inp_next, pa)
-        u, res, it, ok = _solve_core(
-            model, True, mixed, inp_next, sol.x, sol.fluid_pressure, sol.h0
-        )
-        new = _postprocess(model, mixed, inp_next, u, res, it, ok)
-        new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol.iterations)
-        change = changes[0] if changes else jnp.zeros_like(res)
-        return (new, inp_next, change), None
+        return inp_next, settled
 
-    init = (sol, inp, jnp.zeros_like(res))
-    (sol, inp_last, pa_change), _ = jax.lax.scan(picard, init, None, length=n_outer)
+    # Outer (Picard) iteration: Reynolds at fixed temperatures and asperity pressures (Newton, warm
+    # started), then the temperatures of its heat source and the asperity pressure of its film. It
+    # stops once they agree with those the film was solved with (the remaining steps are skipped by
+    # lax.cond: no work when solved one contact at a time; a scan, not a while loop, so that
+    # reverse-mode differentiation works).
+    def picard(carry, _):
+        sol, inp_k, done = carry
+
+        def stay():
+            return sol, inp_k, jnp.asarray(True)
+
+        def step():
+            inp_next, settled = updates(sol, inp_k)
+
+            def solve():
+                u, res, it, ok = _solve_core(model, True, mixed, inp_next, *_warm_args(sol))
+                new = _postprocess(model, mixed, inp_next, u, res, it, ok)
+                new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol.iterations)
+                return new, inp_next, jnp.asarray(False)
+
+            # settled: ``sol`` is the answer for the inputs it was solved with; keep both
+            return jax.lax.cond(settled, stay, solve)
+
+        return jax.lax.cond(done, stay, step), None
+
+    init = (sol, inp, jnp.asarray(False))
+    (sol, inp_last, _), _ = jax.lax.scan(picard, init, None, length=n_outer)
     if statistical:
         # the asperity pressure of the final film agrees with the one the film was solved with
         pa_ok = jnp.max(jnp.abs(asperity_of(sol) - inp_last.asperity_pressure)) <= 1e-3 * ph
@@ -1024,9 +1127,7 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
     temps = jax.tree_util.tree_map(_safe_rise, temps)
     change = jnp.max(jnp.abs(temps.film_mean - inp_last.temperature_rise))
     change = jnp.where(jnp.isfinite(change), change, jnp.finfo(change.dtype).max)
-    # thermally converged: the last Picard step moved the film temperature by < 1 % of its largest
-    # rise (or < 0.05 K)
-    thermal_ok = change <= jnp.maximum(0.01 * jnp.max(jnp.abs(temps.film_mean)), 0.05)
+    thermal_ok = thermal_settled(change, temps.film_mean)
     sol = eqx.tree_at(lambda s: s.converged, sol, sol.converged & thermal_ok)
     return _with_temperatures(sol, temps, inp.contact.inlet_temperature, change), temps
 
@@ -1039,11 +1140,6 @@ def _safe_rise(t):
     """Temperatures of a failed solve are kept finite and bounded (the failure is reported by
     ``converged``), so that the next Picard step and the outputs never carry NaN."""
     return jnp.where(jnp.isfinite(t), jnp.clip(t, -_MAX_RISE, _MAX_RISE), 0.0)
-
-
-@eqx.filter_jit
-def _solve_jit(model, warm, mixed, inp, init_x, init_p, init_h0, solids):
-    return _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids)[0]
 
 
 def solve_ehl(
@@ -1088,7 +1184,6 @@ def solve_ehl(
         EHLSolution (SI, per unit width), with ``converged``, ``residual`` and ``iterations``.
     """
     from ..lubrication.roughness import Surfaces
-    from ..material import steel
 
     model = EHLModel() if model is None else model
     if not isinstance(model, EHLModel):
@@ -1101,27 +1196,77 @@ def solve_ehl(
         raise ValueError(f"contact = {type(contact).__name__} is not valid; valid: a LineContact")
     if not isinstance(lubricant, Lubricant):
         raise ValueError(f"lubricant = {type(lubricant).__name__} is not valid; valid: a Lubricant")
-    n = model.n_nodes
     dtype = jnp.result_type(float)
     if dtype != jnp.float64:
         raise ValueError(
             f"solve_ehl computes in {dtype}; EHL needs float64 (pressures ~1e9 Pa against films "
             "~1e-8 m). Enable it with jax.config.update('jax_enable_x64', True) before use"
         )
-    solids = (steel(), steel()) if solids is None else tuple(solids)
-    x_here = _grid_positions(model, contact, lubricant)
+    solids = _default_solids() if solids is None else tuple(solids)
     if previous is not None:
         if time_step is None:
             raise ValueError(
                 "time_step = None is not valid with previous=; valid range: (0, inf) s"
             )
         check_positive("time_step", time_step, "s")
+    mixed = "smooth" if surfaces is None else model.mixed
+    # numbers become arrays (a Python float would be a static argument of the compiled call below,
+    # one compilation per value)
+    time_step, displacement, temperature_rise = (
+        None if v is None else jnp.asarray(v, dtype=dtype)
+        for v in (time_step, displacement, temperature_rise)
+    )
+    # everything below is array work: one compiled call, so that an eager call from Python costs
+    # the solve and not dozens of dispatches
+    return _solve_entry(
+        model,
+        mixed,
+        contact,
+        lubricant,
+        surfaces,
+        initial,
+        previous,
+        time_step,
+        displacement,
+        solids,
+        temperature_rise,
+    )
+
+
+@functools.cache
+def _default_solids():
+    """(steel, steel): built once (constructing and validating a Material costs ~1 ms eagerly).
+    Built with concrete values even when first called inside a trace (a cached tracer would leak
+    into later compilations)."""
+    from ..material import steel
+
+    with jax.ensure_compile_time_eval():
+        return steel(), steel()
+
+
+@eqx.filter_jit
+def _solve_entry(
+    model,
+    mixed,
+    contact,
+    lubricant,
+    surfaces,
+    initial,
+    previous,
+    time_step,
+    displacement,
+    solids,
+    temperature_rise,
+):
+    n = model.n_nodes
+    dtype = jnp.result_type(float)
+    x_here = _grid_positions(model, contact, lubricant)
+    if previous is not None:
         inv_dt = 1.0 / jnp.asarray(time_step, dtype=dtype)
         rho_h_prev = jnp.interp(x_here, previous.x, previous.rho_h)
     else:
         inv_dt = jnp.zeros((), dtype=dtype)
         rho_h_prev = jnp.zeros((n,), dtype=dtype)
-    mixed = "smooth" if surfaces is None else model.mixed
     sigma = jnp.zeros((), dtype=dtype) if surfaces is None else surfaces.composite_rq
     if mixed != "deterministic":
         offset = jnp.zeros((n,), dtype=dtype)
@@ -1141,11 +1286,9 @@ def solve_ehl(
         seed = jnp.interp(x_here, initial.x, initial.asperity_pressure)
     inp = _Inputs(contact, lubricant, rho_h_prev, inv_dt, offset, rise, seed, sigma)
     if initial is not None:
-        return _solve_jit(
-            model, True, mixed, inp, initial.x, initial.fluid_pressure, initial.h0, solids
-        )
+        return _solve_impl(model, True, mixed, inp, *_warm_args(initial), solids)[0]
     z = jnp.zeros((2,), dtype=dtype)
-    return _solve_jit(model, False, mixed, inp, z, z, jnp.zeros((), dtype=dtype), solids)
+    return _solve_impl(model, False, mixed, inp, z, z, jnp.zeros((), dtype=dtype), solids)[0]
 
 
 def _grid_positions(model: EHLModel, contact: LineContact, lubricant: Lubricant):

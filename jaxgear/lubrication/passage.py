@@ -33,6 +33,7 @@ from .ehl import (
     _grid_positions,
     _Inputs,
     _solve_impl,
+    _warm_args,
 )
 from .lubricant import Lubricant
 from .roughness import Surfaces
@@ -104,9 +105,7 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
             model, False, mixed, inp, x[:2], x[:2], jnp.zeros(()), solids, transient
         )
     else:
-        sol, temps = _solve_impl(
-            model, True, mixed, inp, prev.x, prev.fluid_pressure, prev.h0, solids, transient
-        )
+        sol, temps = _solve_impl(model, True, mixed, inp, *_warm_args(prev), solids, transient)
     if model.thermal:
         temp1 = thermal_mod.transient_update(
             frees[0][0], frees[0][1], temps.flux1, depth
