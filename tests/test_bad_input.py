@@ -198,6 +198,10 @@ def test_line_contact(field, kwargs, value):
         ("fb_smoothing", dict(fb_smoothing=0.0), "0"),
         ("max_iterations", dict(max_iterations=0), "0"),
         ("wedge_order", dict(wedge_order=3), "3"),
+        ("coarsest_nodes", dict(coarsest_nodes=4), "4"),
+        ("coarsest_nodes", dict(coarsest_nodes=65.0), "65.0"),
+        ("auto_domain", dict(auto_domain="yes"), "'yes'"),
+        ("thermal", dict(thermal=1), "1"),
     ],
 )
 def test_ehl_model(field, kwargs, value):

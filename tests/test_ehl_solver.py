@@ -263,3 +263,32 @@ def test_float32_is_refused_with_a_clear_error():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert "ValueError" in out.stdout and "float64" in out.stdout, out.stdout + out.stderr
+
+
+@pytest.mark.parametrize("n_nodes", [65, 257])
+def test_thick_film_below_the_robust_range_stays_finite(n_nodes):
+    """M ≪ 1 (10 N m at 20000 rpm in 20 °C oil: M ≈ 0.05, L ≈ 28) is below the solver's range
+    (M 1-1000): the film is ~500 Hertz units thick and the domain widens to ~200 half-widths, so a
+    coarse grid holds no node inside the Hertz zone. Regression: the cold start normalised an empty
+    Hertz ellipse (0/0) and every output was NaN. Now: converged, or flagged with a finite
+    residual, and every output finite."""
+    c = moes_contact(0.05, 28.0, LUB, slide_to_roll=0.1, t_in=293.15)
+    s = jg.solve_ehl(c, LUB, jg.EHLModel(n_nodes=n_nodes))
+    for leaf in jax.tree_util.tree_leaves(s):
+        assert np.all(np.isfinite(np.asarray(leaf)))
+    assert bool(s.converged) or float(s.residual) >= jg.EHLModel().tolerance
+
+
+def test_default_solids_first_built_inside_a_trace_do_not_leak():
+    """solve_ehl caches its default (steel, steel) pair. Regression: when the cache was first
+    filled inside a jit trace it held that trace's tracers, and the next call of the same
+    compiled function failed ("Execution supplied 21 arguments but compiled program expected
+    24")."""
+    from jaxgear.lubrication import ehl
+
+    ehl._default_solids.cache_clear()
+    model = jg.EHLModel(n_nodes=65)
+    f = eqx.filter_jit(lambda c: jg.solve_ehl(c, LUB, model).h_central)
+    c = gear_contact()
+    assert float(f(c)) == float(f(c))
+    assert float(jg.solve_ehl(c, LUB, model).h_central) == pytest.approx(float(f(c)), rel=1e-12)
