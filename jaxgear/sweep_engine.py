@@ -214,8 +214,10 @@ def _nan_like(shape_dtype_tree, n):
 
 
 @functools.lru_cache(maxsize=32)
-def _batched_with_args(point_fn):
+def _batched_with_args(point_fn, sequential: bool = False):
     """One compiled-function cache per point function, shared by every sweep that uses it."""
+    if sequential:
+        return eqx.filter_jit(lambda xs, args: jax.lax.map(lambda x: point_fn(x, args), xs))
     return eqx.filter_jit(eqx.filter_vmap(point_fn, in_axes=(0, None)))
 
 
@@ -239,6 +241,7 @@ def run_points(
     devices=None,
     converged_key: str | None = "converged",
     label: str = "sweep",
+    sequential: bool = False,
 ) -> SweepOutput:
     """Evaluate ``point_fn`` (one point → pytree of arrays) on every row of ``inputs``.
 
@@ -254,6 +257,10 @@ def run_points(
         progress: print a progress bar on stderr.
         devices: devices to shard each chunk over (default all of ``jax.devices()``).
         label: progress-bar label (also part of the checkpoint fingerprint).
+        sequential: evaluate the points of a chunk one after the other (``lax.map``) instead of
+            vmapped. For point functions with data-dependent fallbacks (``lax.cond``): under vmap a
+            cond becomes a select that runs every branch for every point; on a CPU the vmap gains
+            nothing to pay for that.
     """
     n = _n_points(inputs)
     n_dev = len(list(devices) if devices is not None else jax.devices())
@@ -263,9 +270,10 @@ def run_points(
     fingerprint = _fingerprint((inputs, args), f"{label}:{chunk}")
     ckpt = _prepare_dir(checkpoint_dir, fingerprint)
     if args is None:
-        batched = jax.jit(jax.vmap(point_fn))
+        mapped = functools.partial(jax.lax.map, point_fn) if sequential else jax.vmap(point_fn)
+        batched = jax.jit(mapped)
     else:
-        compiled = _batched_with_args(point_fn)
+        compiled = _batched_with_args(point_fn, sequential)
         batched = lambda xs: compiled(xs, args)
     example = _slice(inputs, 0, 1, pad_to=chunk)
     out_struct = eqx.filter_eval_shape(batched, example)

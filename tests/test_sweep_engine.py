@@ -8,6 +8,7 @@ import sys
 import textwrap
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -38,6 +39,29 @@ def test_chunks_equal_loop_and_status():
     np.testing.assert_allclose(res.outputs["y"], loop, rtol=1e-15)
     np.testing.assert_array_equal(res.status, np.where(xs < 8.5, OK, NOT_CONVERGED))
     assert res.summary()["not converged"] == int(np.sum(xs >= 8.5))
+
+
+def _point_with_args(inp, args):
+    # a data-dependent branch, as the EHL solves' fallbacks
+    y = jax.lax.cond(inp["x"] > args, lambda: jnp.sin(inp["x"]), lambda: -inp["x"])
+    return {"y": y, "converged": inp["x"] < 8.5}
+
+
+@pytest.mark.parametrize("with_args", [False, True])
+def test_sequential_chunks_equal_vmapped(with_args):
+    xs = np.linspace(0.0, 10.0, 11)
+    if with_args:
+        kw = dict(args=jnp.asarray(4.0))
+        fn = _point_with_args
+    else:
+        kw = {}
+        fn = point
+        xs_in = {"x": xs, "a": np.full(11, 2.0)}
+    inputs = {"x": xs} if with_args else xs_in
+    seq = run_points(fn, inputs, chunk_size=4, sequential=True, **kw)
+    par = run_points(fn, inputs, chunk_size=4, **kw)
+    np.testing.assert_allclose(seq.outputs["y"], par.outputs["y"], rtol=1e-15)
+    np.testing.assert_array_equal(seq.status, par.status)
 
 
 def test_non_finite_points_are_flagged_and_others_kept():

@@ -1,8 +1,8 @@
 """The EHL rungs of the coupled model: every tooth-pair contact of a mesh cycle solved by EHL.
 
 Per [position, pair slot] the contact is a line contact with the dynamic (or quasi-static) tooth force
-W_T per face width, the surface velocities and the involute curvature; ``solve_ehl`` is vmapped over
-all of them. Slots that carry no load (out of contact, or unloaded by tip relief) are solved at a
+W_T per face width, the surface velocities and the involute curvature; ``solve_ehl`` is mapped over
+all of them (one after the other: see ``ehl_contact_forces``). Slots that carry no load (out of contact, or unloaded by tip relief) are solved at a
 benign stand-in load and their outputs are masked to zero. Per-unit-width EHL outputs are multiplied
 by the face width: friction forces Fs, Fr (N), damping cm (N s/m, paper Eq. 13), power losses (W).
 """
@@ -82,11 +82,12 @@ def ehl_contact_forces(
         )
 
     flat = lambda x: jnp.reshape(x, (-1,))
-    # Smooth iso-thermal contacts are batched with vmap. Thermal and mixed solves run an outer
-    # (Picard) iteration of Newton solves with cold-start fallbacks behind lax.cond; under vmap a
-    # cond becomes a select that executes every branch, so those contacts are solved one after the
-    # other (lax.map), where a fallback costs only when it is taken.
-    batch = jax.vmap if (model.thermal is False and rough is None) else _sequential
+    # The contacts are solved one after the other (lax.map), not vmapped: each solve has cold-start
+    # fallbacks (and thermal/asperity outer steps) behind lax.cond, and under vmap a cond becomes a
+    # select that executes every branch for every contact. Measured on this 2-core CPU (smooth EHL,
+    # 129 nodes, 64 contacts, benchmarks/RESULTS.md): quasi-static 10.9 s -> 0.61 s per
+    # evaluation, tribo-dynamic 108 s -> 0.8 s, identical results.
+    batch = _sequential
     if initial is None:
         sols = batch(lambda r, wpw, a, b: one(r, wpw, a, b, None))(
             flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s)
