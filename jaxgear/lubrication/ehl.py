@@ -690,18 +690,19 @@ def _hertz_start(level: _Level):
     return jnp.concatenate([p, h0[None]])
 
 
-def _transfer(coarse: _Level, fine: _Level, u):
+def _transfer(coarse: _Level, fine: _Level, u, cubic=False):
+    """Coarse-grid solution → fine-grid start. ``cubic`` (traced bool): midpoints by 4-point cubic
+    interpolation, clipped at zero, instead of linear. Cubic saves 1-2 fine-grid Newton iterations
+    on smooth pressures (the fine LU is the dominant cost); its overshoot next to a sharp pressure
+    spike (Barus at L ≳ 15) can make the fine solve fail, so the second cold attempt uses linear."""
     pc = u[: coarse.n]
-    if fine.n == 2 * coarse.n - 1:
-        # the grid sequence halves Δ: coarse nodes are every other fine node; the midpoints by
-        # 4-point cubic interpolation, clipped at zero (saves 1-2 fine-grid Newton iterations over
-        # linear interpolation: the fine-grid LU is the dominant cost)
+    p = jnp.interp(fine.x, coarse.x, pc)
+    if fine.n == 2 * coarse.n - 1:  # the grid sequence halves Δ: coarse nodes are every other node
         before = jnp.concatenate([pc[:1], pc[:-2]])
         after = jnp.concatenate([pc[2:], pc[-1:]])
         mid = jnp.maximum((9.0 * (pc[:-1] + pc[1:]) - before - after) / 16.0, 0.0)
-        p = jnp.zeros((fine.n,), dtype=pc.dtype).at[::2].set(pc).at[1::2].set(mid)
-    else:
-        p = jnp.interp(fine.x, coarse.x, pc)
+        p_cubic = jnp.zeros((fine.n,), dtype=pc.dtype).at[::2].set(pc).at[1::2].set(mid)
+        p = jnp.where(cubic, p_cubic, p)
     p = p.at[0].set(0.0).at[-1].set(0.0)
     # keep the central film across the transfer (H0 absorbs the O(Δ) change of the discrete kernel)
     hc = jnp.interp(0.0, coarse.x, coarse.film(u))
@@ -727,7 +728,7 @@ def _schedules(model: EHLModel, dtype):
 _INTERMEDIATE_TOLERANCE = 1e-6
 
 
-def _cold_start(model: EHLModel, levels: list[_Level], svals):
+def _cold_start(model: EHLModel, levels: list[_Level], svals, cubic=False):
     """Continuation in the piezo-viscous exponent s (schedule ``svals``) on the coarsest grid, then
     grid
     sequencing up to the second-finest grid; returns the fine-grid start and the iterations
@@ -750,10 +751,10 @@ def _cold_start(model: EHLModel, levels: list[_Level], svals):
     # dwarfs any residual below _INTERMEDIATE_TOLERANCE, so iterating further buys nothing
     tol = max(model.tolerance, _INTERMEDIATE_TOLERANCE)
     for prev, lev in zip(levels[:-2], levels[1:-1], strict=False):
-        u = _transfer(prev, lev, u)
+        u = _transfer(prev, lev, u, cubic)
         u, _, k, _ = _newton(lev, u, 1.0, model.max_iterations, tol)
         iters = iters + k
-    return _transfer(levels[-2], levels[-1], u), iters
+    return _transfer(levels[-2], levels[-1], u, cubic), iters
 
 
 # -------------------------------------------------------------------------------------------------
@@ -818,11 +819,11 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
             # the coarse grids are built here, inside the branch: a warm start never pays for them
             _, levels = _levels(model, inp)
             if mixed != "deterministic":
-                return _cold_start(model, levels, schedules[row])
+                return _cold_start(model, levels, schedules[row], cubic=row == 0)
             # mixed: the smooth problem first, then continuation in the roughness amplitude on the
             # fine grid (coarse grids cannot resolve the roughness anyway)
             smooth = [lev.with_roughness(0.0) for lev in levels]
-            start, k0 = _cold_start(model, smooth, schedules[row])
+            start, k0 = _cold_start(model, smooth, schedules[row], cubic=row == 0)
             steps = model.roughness_steps
             factors = jnp.arange(1, steps, dtype=dtype) / steps
 
