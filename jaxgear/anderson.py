@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import optimistix as optx
 from jax.flatten_util import ravel_pytree
@@ -31,12 +32,20 @@ class Anderson(optx.AbstractFixedPointSolver):
     """Anderson-accelerated fixed-point iteration (see the module docstring).
 
     Attributes:
-        rtol, atol: terminate when max |T(y) − y| / (atol + rtol |T(y)|) < 1 over the core.
+        rtol, atol: terminate when max |T(y) − y| / (atol + rtol |T(y)|) < 1 over the core (or over
+            ``measure``).
         memory: number of previous iterates mixed (static).
         beta: mixing (damping) parameter in (0, 1].
         regularisation: relative Tikhonov regularisation of the least-squares problem.
         core: y ↦ the pytree to mix (static callable).
         replace_core: (y, core) ↦ y with its core replaced (static callable).
+        measure: y ↦ the pytree the termination test is taken on (static callable; default: the
+            core, tested element by element). With a measure the test is leaf by leaf, relative to
+            the leaf's largest magnitude: max |ΔT| < atol + rtol max |T| per leaf, so tables of
+            different units each count in their own scale and entries crossing zero (a friction
+            force changing sign at the pitch point) do not demand an absolute accuracy of atol. It
+            also lets a part of the core that only warm-starts T (it does not change T's value at
+            the fixed point) be mixed without being required to settle.
     """
 
     rtol: float
@@ -47,6 +56,7 @@ class Anderson(optx.AbstractFixedPointSolver):
     regularisation: float = 1e-10
     core: Callable = eqx.field(static=True, default=lambda y: y)
     replace_core: Callable = eqx.field(static=True, default=lambda y, c: c)
+    measure: Callable | None = eqx.field(static=True, default=None)
 
     def init(self, fn, y, args, options, f_struct, aux_struct, tags) -> _AndersonState:
         flat, _ = ravel_pytree(self.core(y))
@@ -86,7 +96,21 @@ class Anderson(optx.AbstractFixedPointSolver):
         ok = jnp.all(jnp.isfinite(mixed))
         new_core = unravel(jnp.where(ok, mixed, gc))  # fall back to a plain step if mixing fails
         new_y = self.replace_core(g_y, new_core)
-        err = jnp.max(jnp.abs(f) / (self.atol + self.rtol * jnp.abs(gc)))
+        if self.measure is None:
+            err = jnp.max(jnp.abs(f) / (self.atol + self.rtol * jnp.abs(gc)))
+        else:  # leaf-wise, relative to each leaf's largest magnitude
+            leaves = zip(
+                jax.tree_util.tree_leaves(self.measure(y)),
+                jax.tree_util.tree_leaves(self.measure(g_y)),
+            )
+            err = jnp.max(
+                jnp.stack(
+                    [
+                        jnp.max(jnp.abs(b - a)) / (self.atol + self.rtol * jnp.max(jnp.abs(b)))
+                        for a, b in leaves
+                    ]
+                )
+            )
         new_state = _AndersonState(
             d_f=d_f, d_g=d_g, prev_f=f, prev_g=gc, count=state.count + 1, relative_error=err
         )

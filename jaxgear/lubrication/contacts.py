@@ -36,7 +36,17 @@ def ehl_model_of(fidelity) -> EHLModel:
 
 
 def ehl_contact_forces(
-    pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature, initial=None
+    pair,
+    lubricant,
+    surfaces,
+    mesh,
+    fidelity,
+    load,
+    u1,
+    u2,
+    inlet_temperature,
+    initial=None,
+    period=None,
 ):
     """Solve all contacts of a mesh cycle by EHL and return ``ContactForces`` [M, 2] (and the raw
     solutions, for warm starts and fields).
@@ -44,16 +54,13 @@ def ehl_contact_forces(
     Args:
         load: tooth force W_T per [position, slot], N. u1, u2: surface velocities, m/s.
         initial: EHLSolution batch [M, 2, ...] to warm-start from (e.g. the previous fixed-point
-            iteration), or None for cold solves.
+            iteration), or None for cold solves. Unused by the transient rung (its passage
+            warm-starts each position from the one before).
+        period: the mesh period, s; needed by ``fidelity.transient`` (the time between positions
+            is period / M).
     """
     from ..tribodynamics import ContactForces
 
-    if fidelity.transient:
-        raise ValueError(
-            "Fidelity.transient = True is not valid in the coupled model yet; valid: False. The "
-            "transient passage exists per contact (jaxgear.lubrication.passage.solve_ehl_passage) "
-            "but is not wired into the tribo-dynamic fixed point"
-        )
     model = ehl_model_of(fidelity)
     rough = surfaces if fidelity.friction == "ehl_mixed" else None
     width = pair.face_width
@@ -88,14 +95,32 @@ def ehl_contact_forces(
     # 129 nodes, 64 contacts, benchmarks/RESULTS.md): quasi-static 10.9 s -> 0.61 s per
     # evaluation, tribo-dynamic 108 s -> 0.8 s, identical results.
     batch = _sequential
-    if initial is None:
-        sols = batch(lambda r, wpw, a, b: one(r, wpw, a, b, None))(
-            flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s)
+    if fidelity.transient:
+        sols = _engagement_passage(
+            mesh.reduced_radius,
+            w,
+            u1s,
+            u2s,
+            loaded & ok_u,
+            period,
+            e_red,
+            inlet_temperature,
+            lubricant,
+            model,
+            rough,
+            tuple(pair.materials),
         )
     else:
-        init_flat = jax.tree_util.tree_map(lambda x: jnp.reshape(x, (-1, *x.shape[2:])), initial)
-        sols = batch(one)(flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s), init_flat)
-    sols = jax.tree_util.tree_map(lambda x: jnp.reshape(x, (*shape, *x.shape[1:])), sols)
+        if initial is None:
+            sols = batch(lambda r, wpw, a, b: one(r, wpw, a, b, None))(
+                flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s)
+            )
+        else:
+            init_flat = jax.tree_util.tree_map(
+                lambda x: jnp.reshape(x, (-1, *x.shape[2:])), initial
+            )
+            sols = batch(one)(flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s), init_flat)
+        sols = jax.tree_util.tree_map(lambda x: jnp.reshape(x, (*shape, *x.shape[1:])), sols)
     mask = (loaded & ok_u).astype(load.dtype)
     fs = sols.friction_sliding * width * mask
     fr = sols.friction_rolling * width * mask
@@ -110,3 +135,62 @@ def ehl_contact_forces(
         converged=jnp.all(jnp.where(mask > 0, sols.converged, True)),
     )
     return forces, sols
+
+
+def _fill_from_valid(values, valid):
+    """Each entry replaced by the nearest valid entry before it (the first valid one for those
+    before any), along the leading axis; unchanged where valid. All-invalid: unchanged."""
+    k = values.shape[0]
+    idx = jnp.arange(k)
+    last = jax.lax.cummax(jnp.where(valid, idx, -1))
+    first = jnp.argmax(valid)
+    src = jnp.where(last >= 0, last, first)
+    return jnp.where(jnp.any(valid), values[src], values)
+
+
+def _engagement_passage(
+    radius, w, u1, u2, valid, period, e_red, inlet_temperature, lubricant, model, rough, solids
+):
+    """The transient rung: one tooth pair marched through its whole engagement.
+
+    In the periodic steady state every tooth pair has the same history, and one pair's engagement is
+    slot 0 over a mesh period followed by slot 1 over the next (MeshCycle). The 2M states are marched
+    in that order by ``solve_ehl_passage`` (squeeze term ∂(ρh)/∂t by backward Euler with
+    Δt = period / M, surface temperatures with memory when thermal), and the solutions are put back
+    on the [M, 2] table. States out of contact are masked out by the caller; here they carry the
+    nearest loaded state before them (the first loaded one before entry), so the march never jumps
+    through a stand-in load and back, which would be a spurious squeeze.
+    """
+    from .passage import solve_ehl_passage
+
+    if period is None:
+        raise ValueError("period (the mesh period, s) is needed by Fidelity.transient = True")
+    if rough is not None and model.mixed == "deterministic":
+        raise ValueError(
+            "Fidelity.transient = True with mixed_model = 'deterministic' is not valid; valid: "
+            "mixed_model = 'statistical'. Between two mesh positions the roughness moves by "
+            "u·period/M, about a third of the Hertz width, far more than the grid cell the moving "
+            "profiles need (EHL_NOTES: Δt ≤ Δx/u); march one contact with solve_ehl_passage and "
+            "grid_time_step instead"
+        )
+    m = w.shape[0]
+    # [M, 2] → one engagement of 2M states: slot 0's positions, then slot 1's.
+    seq = lambda a: jnp.reshape(jnp.swapaxes(a, 0, 1), (-1,))
+    ok = seq(valid)
+    fill = lambda a: _fill_from_valid(seq(a), ok)
+    contacts = LineContact(
+        reduced_radius=fill(radius),
+        load_per_width=fill(w),
+        u1=fill(u1),
+        u2=fill(u2),
+        e_reduced=jnp.broadcast_to(e_red, (2 * m,)),
+        inlet_temperature=jnp.broadcast_to(inlet_temperature, (2 * m,)),
+    )
+    times = jnp.arange(2 * m) * (period / m)
+    sols = solve_ehl_passage(
+        contacts, lubricant, model, rough, times=times, solids=solids
+    )
+    # back to [M, 2, ...]
+    return jax.tree_util.tree_map(
+        lambda x: jnp.swapaxes(jnp.reshape(x, (2, m, *x.shape[1:])), 0, 1), sols
+    )
