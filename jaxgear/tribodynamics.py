@@ -311,14 +311,24 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         # Before the first orbit exists, shoot from the static equilibrium (NaN guess).
         guess = jnp.where(state["started"] > 0.5, state["guess"], jnp.nan)
         resp = respond(interface, guess)
-        u = resp.surface_velocity
+        # A shooting that diverged from the warm start (NaN orbit: seen at 3400 rpm at the paper
+        # fidelity, next to the unstable band) must not poison the tables: the contacts keep the
+        # last finite loads and velocities, and the next iteration shoots cold.
+        finite = (
+            jnp.all(jnp.isfinite(resp.initial_state))
+            & jnp.all(jnp.isfinite(resp.tooth_force))
+            & jnp.all(jnp.isfinite(resp.surface_velocity))
+            & jnp.all(jnp.isfinite(resp.dynamic_te))
+        )
+        load = jnp.where(finite, resp.tooth_force, state["load"])
+        u = jnp.where(finite, resp.surface_velocity, state["velocity"])
         forces, contacts = contact_forces(
             pair,
             lubricant,
             surfaces,
             mesh,
             fidelity,
-            resp.tooth_force,
+            load,
             u[..., 0],
             u[..., 1],
             op.inlet_temperature,
@@ -329,13 +339,13 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         relaxed = jax.tree_util.tree_map(lambda a, b: (1.0 - beta) * a + beta * b, interface, new)
         return {
             "interface": relaxed,
-            "guess": resp.initial_state,
-            "load": resp.tooth_force,
+            "guess": jnp.where(finite, resp.initial_state, state["guess"]),
+            "load": load,
             "velocity": u,
-            "dte": resp.dynamic_te,
+            "dte": jnp.where(finite, resp.dynamic_te, state["dte"]),
             "forces": forces,
-            "dynamics_ok": jnp.where(resp.status == 0, 1.0, 0.0),
-            "started": jnp.ones_like(state["started"]),
+            "dynamics_ok": jnp.where(finite & (resp.status == 0), 1.0, 0.0),
+            "started": jnp.where(finite, 1.0, 0.0) * jnp.ones_like(state["started"]),
             "previous": interface.friction_1,
             "contacts": contacts,
         }

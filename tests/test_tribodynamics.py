@@ -177,3 +177,56 @@ def test_bad_input(setup):
         simulate(pair, lub, surf, op, fidelity="fast")
     with pytest.raises(ValueError, match=r"OperatingPoint.speed_rpm = -5"):
         jg.OperatingPoint(torque=700.0, speed_rpm=-5.0)
+
+
+def _central(f, x, h):
+    return (f(x + h) - f(x - h)) / (2 * h)
+
+
+@pytest.mark.slow
+def test_gradient_quasi_static_smooth_ehl_wrt_relief_and_torque(setup):
+    # The EHL rung: every contact's friction, damping and losses differentiated implicitly (no
+    # back-propagation through the Newton iterations) and summed over the cycle.
+    pair, lub, surf = setup
+    fid = Fidelity(dynamics="quasi_static", friction="ehl_smooth", n_positions=24, n_nodes=65)
+
+    def eff(amount, torque):
+        p = jg.presets.li2015_pair(tip_relief=amount)
+        return simulate(
+            p, lub, surf, jg.OperatingPoint(torque=torque, speed_rpm=2000.0), fid
+        ).efficiency
+
+    g = jax.jacfwd(eff, argnums=(0, 1))(jnp.asarray(10e-6), jnp.asarray(700.0))
+    fd_relief = _central(lambda a: eff(a, jnp.asarray(700.0)), jnp.asarray(10e-6), 1e-7)
+    fd_torque = _central(lambda t: eff(jnp.asarray(10e-6), t), jnp.asarray(700.0), 1.0)
+    # The contacts are converged to ‖F‖∞ < 1e-8, so Φ̄ carries ~1e-8 relative noise: with steps of
+    # 1 % of the relief and 1/700 of the torque the differences' noise is ≲ 1e-5 and their
+    # truncation ~1e-4 of the derivative. 1e-3 relative.
+    assert float(g[0]) == pytest.approx(float(fd_relief), rel=1e-3)
+    assert float(g[1]) == pytest.approx(float(fd_torque), rel=1e-3)
+
+
+@pytest.mark.slow
+def test_gradient_quasi_static_paper_physics_wrt_roughness_and_torque(setup):
+    # The paper's contact physics (thermal, statistical mixed, transient) at a reduced resolution.
+    pair, lub, _ = setup
+    fid = Fidelity.paper(dynamics="quasi_static", n_positions=24, n_nodes=129)
+
+    def eff(scale, torque):
+        return simulate(
+            pair,
+            lub,
+            jg.presets.ground(scale=scale),
+            jg.OperatingPoint(torque=torque, speed_rpm=2000.0),
+            fid,
+        ).efficiency
+
+    g = jax.jacfwd(eff, argnums=(0, 1))(jnp.asarray(1.0), jnp.asarray(700.0))
+    fd_scale = _central(lambda s: eff(s, jnp.asarray(700.0)), jnp.asarray(1.0), 0.02)
+    fd_torque = _central(lambda t: eff(jnp.asarray(1.0), t), jnp.asarray(700.0), 14.0)
+    # The thermal and asperity Picard loops stop at 1 % of the temperature rise and 1e-3 ph, so Φ̄
+    # is reproducible to ~1e-4 relative only: steps of 2 % keep that noise at ≲ 1e-2 of the
+    # derivative (truncation ~4e-4). 3e-2 relative; the sign and size are what a designer uses.
+    assert float(g[0]) == pytest.approx(float(fd_scale), rel=3e-2)
+    assert float(g[1]) == pytest.approx(float(fd_torque), rel=3e-2)
+    assert float(g[0]) < 0  # rougher surfaces, more asperity friction, lower efficiency

@@ -187,9 +187,7 @@ def _engagement_passage(
         inlet_temperature=jnp.broadcast_to(inlet_temperature, (2 * m,)),
     )
     times = jnp.arange(2 * m) * (period / m)
-    sols = solve_ehl_passage(
-        contacts, lubricant, model, rough, times=times, solids=solids
-    )
+    sols = solve_ehl_passage(contacts, lubricant, model, rough, times=times, solids=solids)
     # back to [M, 2, ...]
     return jax.tree_util.tree_map(
         lambda x: jnp.swapaxes(jnp.reshape(x, (2, m, *x.shape[1:])), 0, 1), sols

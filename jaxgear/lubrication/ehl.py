@@ -1124,8 +1124,7 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
         sol = eqx.tree_at(lambda s: s.converged, sol, sol.converged & pa_ok)
     if not model.thermal:
         return sol, None
-    temps = _temperatures(inp_last, sol, solids, transient)
-    temps = jax.tree_util.tree_map(_safe_rise, temps)
+    temps = _finite_temperatures(_temperatures(inp_last, sol, solids, transient))
     change = jnp.max(jnp.abs(temps.film_mean - inp_last.temperature_rise))
     change = jnp.where(jnp.isfinite(change), change, jnp.finfo(change.dtype).max)
     thermal_ok = thermal_settled(change, temps.film_mean)
@@ -1141,6 +1140,20 @@ def _safe_rise(t):
     """Temperatures of a failed solve are kept finite and bounded (the failure is reported by
     ``converged``), so that the next Picard step and the outputs never carry NaN."""
     return jnp.where(jnp.isfinite(t), jnp.clip(t, -_MAX_RISE, _MAX_RISE), 0.0)
+
+
+def _finite_temperatures(temps):
+    """The temperature rises bounded by ``_safe_rise``; the heat fluxes (W/m², ~1e8-1e9 in a gear
+    contact: never clipped to the temperature bound) only made finite."""
+    rise = ("surface1", "surface2", "film_mean")
+    finite = lambda a, fill: jnp.where(jnp.isfinite(a), a, fill)
+    return eqx.tree_at(
+        lambda t: (t.surface1, t.surface2, t.film_mean, t.flux1, t.flux2, t.convected, t.partition),
+        temps,
+        tuple(_safe_rise(getattr(temps, f)) for f in rise)
+        + tuple(finite(getattr(temps, f), 0.0) for f in ("flux1", "flux2", "convected"))
+        + (finite(temps.partition, 0.5),),
+    )
 
 
 def solve_ehl(
