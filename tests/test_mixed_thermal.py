@@ -279,4 +279,6 @@ def test_thermal_passage_of_a_steady_state_reaches_the_steady_temperatures():
         # at slide-to-roll 0.3).
         assert rises[-1] == pytest.approx(rise_steady, rel=0.02)
     # friction follows the film temperature: within 0.2 % of the steady value
-    assert float(sols.friction_sliding[-1]) == pytest.approx(float(steady.friction_sliding), rel=2e-3)
+    assert float(sols.friction_sliding[-1]) == pytest.approx(
+        float(steady.friction_sliding), rel=2e-3
+    )

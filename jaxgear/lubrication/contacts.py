@@ -122,17 +122,28 @@ def ehl_contact_forces(
             sols = batch(one)(flat(mesh.reduced_radius), flat(w), flat(u1s), flat(u2s), init_flat)
         sols = jax.tree_util.tree_map(lambda x: jnp.reshape(x, (*shape, *x.shape[1:])), sols)
     mask = (loaded & ok_u).astype(load.dtype)
-    fs = sols.friction_sliding * width * mask
-    fr = sols.friction_rolling * width * mask
+    # A failed contact solve can leave non-finite outputs (seen: a 200 N touch just before the
+    # teeth separate, at the paper fidelity). It is reported (``converged`` False → the coupled
+    # model's status 3), and contributes nothing rather than NaN to the tables and the loss.
+    outputs = (
+        sols.friction_sliding,
+        sols.friction_rolling,
+        sols.damping,
+        sols.power_loss_sliding,
+        sols.power_loss_rolling,
+    )
+    finite = jnp.all(jnp.stack([jnp.isfinite(a) for a in outputs]), axis=0)
+    take = lambda a: jnp.where(finite, a, 0.0) * width * mask
+    fs, fr = take(sols.friction_sliding), take(sols.friction_rolling)
     forces = ContactForces(
         friction_sliding=fs,
         friction_rolling=fr,
-        damping=sols.damping * width * mask,
-        power_sliding=sols.power_loss_sliding * width * mask,
+        damping=take(sols.damping),
+        power_sliding=take(sols.power_loss_sliding),
         # (the sliding loss includes the asperity (boundary) friction of mixed lubrication)
-        power_rolling=sols.power_loss_rolling * width * mask,
+        power_rolling=take(sols.power_loss_rolling),
         friction_coefficient=jnp.sqrt(fs**2 + fr**2) / jnp.where(loaded, load, 1.0) * mask,
-        converged=jnp.all(jnp.where(mask > 0, sols.converged, True)),
+        converged=jnp.all(jnp.where(mask > 0, sols.converged & finite, True)),
     )
     return forces, sols
 

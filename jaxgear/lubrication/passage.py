@@ -73,14 +73,21 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         inv_dt = jnp.zeros(())
         rise = jnp.zeros_like(x)
     else:
-        rho_h_prev = jnp.interp(x, prev.x, prev.rho_h)
-        inv_dt = 1.0 / dt
+        # A failed previous step (reported by its ``converged``) carries no usable film: this step
+        # restarts as a steady solve (no squeeze, film at the inlet temperature) instead of
+        # inheriting its state, so one failure (e.g. a near-zero load where the teeth separate)
+        # does not fail every later step.
+        prev_ok = prev.converged & jnp.all(jnp.isfinite(prev.rho_h))
+        prev_ok = prev_ok & jnp.all(jnp.isfinite(prev.temperature))
+        rho_h_prev = jnp.where(prev_ok, jnp.interp(x, prev.x, prev.rho_h), 0.0)
+        inv_dt = jnp.where(prev_ok, 1.0 / dt, 0.0)
         rise = jnp.interp(x, prev.x, prev.temperature - inlet, left=0.0, right=0.0)
+        rise = jnp.where(prev_ok, rise, 0.0)
     sigma = jnp.zeros(()) if surfaces is None else surfaces.composite_rq
     if first:
         seed = jnp.zeros_like(x)
     else:
-        seed = jnp.interp(x, prev.x, prev.asperity_pressure)
+        seed = jnp.where(prev_ok, jnp.interp(x, prev.x, prev.asperity_pressure), 0.0)
     inp = _Inputs(
         contact,
         lubricant,
