@@ -172,9 +172,7 @@ class Runner:
         if key in self.cache["compile"] or self.cache.get("available", {}).get(key):
             return None
         try:
-            t0 = time.perf_counter()
             lowered = SIM.lower(*probe.inputs(self.pair), fid)
-            lower_s = time.perf_counter() - t0
             why = self._no_effect(fid, lowered, probe)
         except ValueError as err:
             why = f"ValueError: {err}"
