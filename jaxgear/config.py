@@ -384,7 +384,9 @@ def _fidelity_keys() -> dict:
 
     keys: dict[str, Any] = {"preset": str}
     for f in dataclasses.fields(Fidelity):
-        keys[f.name] = {bool: bool, int: int, float: float, str: str}[type(f.default)]
+        # a None default (fixed_point_tolerance: chosen by the rung) is given as a number or left out
+        kind = float if f.default is None else type(f.default)
+        keys[f.name] = {bool: bool, int: int, float: float, str: str}[kind]
     return keys
 
 
