@@ -311,9 +311,10 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         # Before the first orbit exists, shoot from the static equilibrium (NaN guess).
         guess = jnp.where(state["started"] > 0.5, state["guess"], jnp.nan)
         resp = respond(interface, guess)
-        # A shooting that diverged from the warm start (NaN orbit: seen at 3400 rpm at the paper
-        # fidelity, next to the unstable band) must not poison the tables: the contacts keep the
-        # last finite loads and velocities, and the next iteration shoots cold.
+        # A shooting that diverged (NaN orbit) must not poison the tables: the contacts keep the
+        # last finite loads and velocities, and the next iteration shoots cold. (Seen at 3400 rpm at
+        # the paper fidelity, where NaN contact outputs made the shooting diverge; those are now
+        # kept finite at their source, contacts.ehl_contact_forces. This is the second guard.)
         finite = (
             jnp.all(jnp.isfinite(resp.initial_state))
             & jnp.all(jnp.isfinite(resp.tooth_force))
