@@ -51,6 +51,8 @@ class SweepResult(eqx.Module):
         inputs: dict of the varied inputs (SI; speed in rpm) [N].
         power_loss, power_loss_sliding, power_loss_rolling (W), efficiency, dte_rms (m),
         fixed_point_residual: [N] (NaN where a point failed).
+        failed_contacts: [N] loaded contacts per point whose EHL solve failed (0 where a point's
+            chunk failed: see ``status``).
         power_loss_position: Φ(t_i) per point, W [N, M].
         tooth_force: W_T per point, position and pair slot, N [N, M, 2]; surface_velocity: uj, m/s
             [N, M, 2, 2]; hertz_pressure: Hertz pressure of W_T, Pa [N, M, 2] (as in SimulationResult).
@@ -67,6 +69,7 @@ class SweepResult(eqx.Module):
     efficiency: np.ndarray
     dte_rms: np.ndarray
     fixed_point_residual: np.ndarray
+    failed_contacts: np.ndarray
     power_loss_position: np.ndarray
     tooth_force: np.ndarray
     surface_velocity: np.ndarray
@@ -102,6 +105,7 @@ class SweepResult(eqx.Module):
             efficiency_percent=100.0 * np.asarray(self.efficiency),
             dte_rms_um=1e6 * np.asarray(self.dte_rms),
             fixed_point_residual=self.fixed_point_residual,
+            failed_contacts=self.failed_contacts,
             status=self.status,
         )
         names = list(cols)
@@ -135,6 +139,7 @@ def _outputs(result):
     for k in _PER_POSITION:
         out[k] = getattr(result, k)
     out["sim_status"] = result.status
+    out["failed_contacts"] = result.failed_contacts
     out["converged"] = result.converged
     return out
 
@@ -278,6 +283,7 @@ def sweep(
         efficiency=np.asarray(out["efficiency"]),
         dte_rms=np.asarray(out["dte_rms"]),
         fixed_point_residual=np.asarray(out["fixed_point_residual"]),
+        failed_contacts=np.asarray(out["failed_contacts"]),
         power_loss_position=np.asarray(out["power_loss_position"]),
         tooth_force=np.asarray(out["tooth_force"]),
         surface_velocity=np.asarray(out["surface_velocity"]),

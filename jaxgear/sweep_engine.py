@@ -158,6 +158,9 @@ def _load(checkpoint_dir: Path | None, index: int, out_treedef, carry_treedef=No
         return None
     with np.load(path) as data:
         n_leaves = out_treedef.num_leaves
+        if sum(k.startswith("leaf") for k in data.files) != n_leaves:
+            # written by a version of jaxgear with other outputs: recomputed, never misread
+            return None
         out = jax.tree_util.tree_unflatten(out_treedef, [data[f"leaf{i}"] for i in range(n_leaves)])
         status = data["status"]
         carry = None

@@ -68,6 +68,8 @@ class ContactForces(eqx.Module):
         power_rolling: rolling part of Φn, W.
         friction_coefficient: (Fs² + Fr²)^½ / W_T where loaded (informative), dimensionless.
         converged: every contact solve converged.
+        failed: number of loaded contacts whose solve failed (their outputs are carried over from
+            the nearest good contact; see ``contacts._patch_failed``).
     """
 
     friction_sliding: Float[Array, "M 2"]
@@ -77,6 +79,7 @@ class ContactForces(eqx.Module):
     power_rolling: Float[Array, "M 2"]
     friction_coefficient: Float[Array, "M 2"]
     converged: Bool[Array, ""]
+    failed: Int[Array, ""]
 
 
 def _smooth_sign(x, width):
@@ -134,6 +137,7 @@ def formula_contact_forces(
         power_rolling=zeros,
         friction_coefficient=mu,
         converged=jnp.asarray(True),
+        failed=jnp.asarray(0, dtype=jnp.int32),
     )
 
 
@@ -196,6 +200,9 @@ class SimulationResult(eqx.Module):
         fixed_point_residual: |T(y) − y| of the friction table F1 relative to its maximum, in the
             last fixed-point evaluation;
         fixed_point_iterations: iterations used (0 for quasi-static).
+        failed_contacts: loaded contacts of the cycle whose EHL solve failed (status 3); their
+            outputs are carried over from the nearest good contact of the engagement, never used as
+            they came out.
     """
 
     power_loss: Float[Array, ""]
@@ -218,6 +225,7 @@ class SimulationResult(eqx.Module):
     status: Int[Array, ""]
     fixed_point_residual: Float[Array, ""]
     fixed_point_iterations: Int[Array, ""]
+    failed_contacts: Int[Array, ""]
 
 
 def kinematic_velocities(pair: GearPair, mesh: MeshCycle, omega1):
@@ -268,6 +276,7 @@ def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, ite
         status=jnp.asarray(status, dtype=jnp.int32),
         fixed_point_residual=jnp.asarray(residual, dtype=loss.dtype),
         fixed_point_iterations=jnp.asarray(iterations, dtype=jnp.int32),
+        failed_contacts=jnp.asarray(forces.failed, dtype=jnp.int32),
     )
 
 
