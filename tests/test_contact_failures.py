@@ -69,9 +69,7 @@ def test_contacts_out_of_use_stay_zero_and_all_failed_gives_zeros():
 def test_coarse_transient_at_1500_nm_is_flagged_and_stays_physical():
     pair, lub = jg.presets.li2015_pair_calibrated(), jg.presets.mil_l_23699()
     op = jg.OperatingPoint(torque=1500.0, speed_rpm=2500.0, inlet_temperature=363.15)
-    fid = jg.Fidelity(
-        dynamics="quasi_static", friction="ehl_smooth", n_positions=24, n_nodes=65
-    )
+    fid = jg.Fidelity(dynamics="quasi_static", friction="ehl_smooth", n_positions=24, n_nodes=65)
     steady = jg.simulate(pair, lub, jg.presets.ground(), op, fidelity=fid)
     marched = jg.simulate(pair, lub, jg.presets.ground(), op, fidelity=fid.replace(transient=True))
     # 65 nodes are too coarse for 1.4 GPa: some contacts fail in both; they are flagged and counted.
