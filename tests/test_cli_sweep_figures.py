@@ -201,6 +201,15 @@ def test_figures_quick_cli(tmp_path, capsys, monkeypatch):
     assert "temperature part not evaluated" in rows["R11"]["note"]
 
 
+@pytest.mark.parametrize("step", ["2", "4000", "nan"])
+def test_figures_bad_speed_step_exits_2_naming_the_option(tmp_path, capsys, step):
+    out = tmp_path / "figs"
+    assert main(["figures", "--speed-step", step, "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "--speed-step" in err and "5 to 1850 rpm" in err
+    assert not out.exists()  # nothing written for bad input
+
+
 @pytest.mark.slow
 def test_figures_quick_fast_fidelity(tmp_path, capsys):
     out = tmp_path / "figs"
@@ -234,3 +243,26 @@ def test_contact_fields_on_an_ehl_rung():
     assert len(fig.axes) == 4  # p and h at B and E; no temperature row (iso-thermal)
     with pytest.raises(jg.figures.FigureUnavailable, match="mixed EHL rung"):
         jg.figures.figure(repro, 12)
+
+
+@pytest.mark.slow
+def test_fig12_solves_the_roughness_deterministically_on_the_mixed_rung():
+    # R10: at the mixed rung, Fig. 12 solves the 17° contact at speed E with the roughness profiles
+    # (513 nodes, iso-thermal snapshot); loads and velocities from a cheap quasi-static run.
+    from jaxgear.figures import _contact_fields
+
+    repro = jg.figures.reproduce_paper(
+        Fidelity(dynamics="quasi_static"), quick=True, speeds_rpm=[1800.0, 3500.0]
+    )
+    mixed = Fidelity(
+        dynamics="quasi_static", friction="ehl_mixed", thermal=False, n_positions=24, n_nodes=129
+    )
+    repro = dataclasses.replace(repro, fidelity=mixed, fields={})
+    _contact_fields(repro)
+    g, p = repro.fields["fig12_ground"], repro.fields["fig12_polished"]
+    assert "deterministic" in g.model and "deterministic" in p.model
+    assert bool(g.solution.converged) and bool(p.solution.converged)
+    assert float(g.solution.p_max) > 3.0e9  # asperity pressures (paper: above 3 GPa)
+    assert float(p.solution.p_max) < 2.0e9 and float(p.solution.h_min) > 0.0  # full film
+    fig = jg.figures.figure(repro, 12)
+    assert len(fig.axes) == 4  # p and h, ground and polished; iso-thermal: no temperature row

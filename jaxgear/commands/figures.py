@@ -14,6 +14,7 @@ rung) is skipped with the reason printed, never drawn from something else. ``--q
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 
@@ -31,6 +32,15 @@ def register(sub) -> None:
     )
     p.add_argument("--out", type=Path, default=Path("results/figures"), help="output directory")
     p.add_argument("--quick", action="store_true", help="reduced run (seven speeds, 24 positions)")
+    p.add_argument(
+        "--speed-step",
+        type=float,
+        default=25.0,
+        metavar="RPM",
+        help="step of the baseline sweep over 500-4200 rpm (default 25, the paper's; variants "
+        "every 100 rpm or this step if larger). Steps above 50 rpm cannot locate the DTE peaks: the "
+        "points A-E are then placed at their nominal speeds",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
@@ -39,15 +49,30 @@ def run(args: argparse.Namespace) -> int:
     import json
     import time
 
+    import numpy as np
+
     from jaxgear.fidelity import Fidelity
     from jaxgear.figures import reproduce_paper, table_markdown, write_report
 
+    speeds = variant_speeds = None
+    if not args.quick:
+        if not (5.0 <= args.speed_step <= 1850.0):
+            print(
+                f"jaxgear figures: --speed-step = {args.speed_step:g} rpm is not valid; valid "
+                "range: 5 to 1850 rpm",
+                file=sys.stderr,
+            )
+            return 2
+        speeds = np.arange(500.0, 4200.0 + 1e-9, args.speed_step)
+        variant_speeds = speeds if args.speed_step > 100.0 else None
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     repro = reproduce_paper(
         Fidelity.named(args.fidelity),
         quick=args.quick,
+        speeds_rpm=speeds,
+        variant_speeds_rpm=variant_speeds,
         checkpoint_dir=out / "checkpoint",
         progress=not args.no_progress,
     )
