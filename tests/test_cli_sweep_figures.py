@@ -210,6 +210,15 @@ def test_figures_bad_speed_step_exits_2_naming_the_option(tmp_path, capsys, step
     assert not out.exists()  # nothing written for bad input
 
 
+def test_figures_variant_step_must_be_a_multiple_of_the_speed_step(tmp_path, capsys):
+    out = tmp_path / "figs"
+    args = ["figures", "--speed-step", "100", "--variant-step", "150", "--out", str(out)]
+    assert main([*args, "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "--variant-step = 150 rpm" in err and "multiple of --speed-step (100 rpm)" in err
+    assert not out.exists()
+
+
 @pytest.mark.slow
 def test_figures_quick_fast_fidelity(tmp_path, capsys):
     out = tmp_path / "figs"

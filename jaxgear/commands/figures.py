@@ -37,9 +37,16 @@ def register(sub) -> None:
         type=float,
         default=25.0,
         metavar="RPM",
-        help="step of the baseline sweep over 500-4200 rpm (default 25, the paper's; variants "
-        "every 100 rpm or this step if larger). Steps above 50 rpm cannot locate the DTE peaks: the "
-        "points A-E are then placed at their nominal speeds",
+        help="step of the baseline sweep over 500-4200 rpm (default 25, the paper's). Steps above "
+        "50 rpm cannot locate the DTE peaks: the points A-E are then placed at their nominal speeds",
+    )
+    p.add_argument(
+        "--variant-step",
+        type=float,
+        default=100.0,
+        metavar="RPM",
+        help="step of the variant sweeps (60 °C, 1500 N m, polished, iso-thermal), a multiple of "
+        "--speed-step (default 100, or --speed-step if larger)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
@@ -64,7 +71,16 @@ def run(args: argparse.Namespace) -> int:
             )
             return 2
         speeds = np.arange(500.0, 4200.0 + 1e-9, args.speed_step)
-        variant_speeds = speeds if args.speed_step > 100.0 else None
+        step = max(args.variant_step, args.speed_step)
+        ratio = step / args.speed_step
+        if not (np.isfinite(ratio) and abs(ratio - round(ratio)) < 1e-9):
+            print(
+                f"jaxgear figures: --variant-step = {args.variant_step:g} rpm is not valid; valid: "
+                f"a multiple of --speed-step ({args.speed_step:g} rpm)",
+                file=sys.stderr,
+            )
+            return 2
+        variant_speeds = speeds[:: int(round(ratio))]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
