@@ -217,6 +217,8 @@ def test_figures_variant_step_must_be_a_multiple_of_the_speed_step(tmp_path, cap
     err = capsys.readouterr().err
     assert "--variant-step = 150 rpm" in err and "multiple of --speed-step (100 rpm)" in err
     assert not out.exists()
+    assert main(["figures", "--variant-step", "-200", "--out", str(out), "--no-progress"]) == 2
+    assert "--variant-step = -200 rpm" in capsys.readouterr().err
 
 
 @pytest.mark.slow

@@ -73,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
         speeds = np.arange(500.0, 4200.0 + 1e-9, args.speed_step)
         step = max(args.variant_step, args.speed_step)
         ratio = step / args.speed_step
-        if not (np.isfinite(ratio) and abs(ratio - round(ratio)) < 1e-9):
+        ok = args.variant_step > 0 and np.isfinite(ratio)
+        if not (ok and abs(ratio - round(ratio)) < 1e-9):
             print(
                 f"jaxgear figures: --variant-step = {args.variant_step:g} rpm is not valid; valid: "
                 f"a multiple of --speed-step ({args.speed_step:g} rpm)",

@@ -163,13 +163,14 @@ def _patch_failed(outputs, good, failed, w, u1, u2):
     the sliding velocity across the pitch point. The contact stays reported: ``converged`` is False
     (status 3) and ``failed`` counts it. No good contact at all: zeros.
     """
+    from ..tribodynamics import SIGN_SLIDE_TO_ROLL
+
     fs, fr, cm, ps, pr = outputs
     m = w.shape[0]
     us = u2 - u1
     um = 0.5 * (u1 + u2)
-    sign = us / jnp.sqrt(us**2 + (0.02 * um) ** 2)
-    slip = jnp.sqrt(us**2 + (0.02 * um) ** 2)
-    scale = (w * sign, w, jnp.ones_like(w), w * slip, w * um)
+    slip = jnp.sqrt(us**2 + (SIGN_SLIDE_TO_ROLL * um) ** 2)
+    scale = (w * us / slip, w, jnp.ones_like(w), w * slip, w * um)
     seq = lambda a: jnp.reshape(jnp.swapaxes(a, 0, 1), (-1,))
     unseq = lambda a: jnp.swapaxes(jnp.reshape(a, (2, m)), 0, 1)
     ok = seq(good)
@@ -183,26 +184,18 @@ def _patch_failed(outputs, good, failed, w, u1, u2):
     return tuple(out)
 
 
-def _fill_nearest(values, valid):
-    """Each invalid entry replaced by the nearest valid one along the leading axis (the one before
-    on a tie); unchanged where valid or where none is valid."""
+def _fill_nearest(values, valid, causal=False):
+    """Each invalid entry replaced by the nearest valid one along the leading axis (the one before on
+    a tie; ``causal``: the one before whenever there is one, else the first valid one); unchanged
+    where valid or where none is valid."""
     k = values.shape[0]
     idx = jnp.arange(k)
     before = jax.lax.cummax(jnp.where(valid, idx, -1))
     after = jax.lax.cummin(jnp.where(valid, idx, k), reverse=True)
-    use_before = (before >= 0) & ((after >= k) | (idx - before <= after - idx))
+    use_before = before >= 0
+    if not causal:
+        use_before = use_before & ((after >= k) | (idx - before <= after - idx))
     src = jnp.clip(jnp.where(use_before, before, after), 0, k - 1)
-    return jnp.where(jnp.any(valid), values[src], values)
-
-
-def _fill_from_valid(values, valid):
-    """Each entry replaced by the nearest valid entry before it (the first valid one for those
-    before any), along the leading axis; unchanged where valid. All-invalid: unchanged."""
-    k = values.shape[0]
-    idx = jnp.arange(k)
-    last = jax.lax.cummax(jnp.where(valid, idx, -1))
-    first = jnp.argmax(valid)
-    src = jnp.where(last >= 0, last, first)
     return jnp.where(jnp.any(valid), values[src], values)
 
 
@@ -235,7 +228,7 @@ def _engagement_passage(
     # [M, 2] → one engagement of 2M states: slot 0's positions, then slot 1's.
     seq = lambda a: jnp.reshape(jnp.swapaxes(a, 0, 1), (-1,))
     ok = seq(valid)
-    fill = lambda a: _fill_from_valid(seq(a), ok)
+    fill = lambda a: _fill_nearest(seq(a), ok, causal=True)
     contacts = LineContact(
         reduced_radius=fill(radius),
         load_per_width=fill(w),

@@ -164,10 +164,11 @@ class EHLModel(eqx.Module):
             solve continues adaptively in the roughness amplitude from the smooth film. Measured
             with ``presets.ground()`` at the paper's pitch contact: converges at 3500 rpm
             (λ ≈ 0.4) on 257-1025 nodes; at 500 rpm (λ ≈ 0.1) on 257 nodes but not on 1025, where
-            the continuation stalls at 0.43 of the roughness (reported as not converged). "statistical": the mean film with the
-            Greenwood-Tripp asperity pressure p_a(h) (``asperity.py``) added to the load and the
-            deformation (Johnson-Greenwood-Poon load sharing), iterated with the temperatures;
-            robust down to λ → 0; it needs only the composite roughness σ.
+            the continuation stalls at 0.43 of the roughness (reported as not converged).
+            "statistical": the mean film with the Greenwood-Tripp asperity pressure p_a(h)
+            (``asperity.py``) added to the load and the deformation (Johnson-Greenwood-Poon load
+            sharing), iterated with the temperatures; robust down to λ → 0; it needs only the
+            composite roughness σ.
         asperity_density_product, asperity_slope_ratio: nβσ and σ/β of the statistical model
             [typical values for ground steel: 0.05, 0.01].
         asperity_relaxation: under-relaxation of the asperity-pressure update (statistical).
