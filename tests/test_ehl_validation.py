@@ -38,19 +38,16 @@ def test_moes_central_film_moderate_load(m, l):
 @pytest.mark.parametrize("l", [3.0, 8.0, 15.0])
 def test_moes_central_film_full_range(m, l):
     # high M needs fine grids (REFERENCE §8): 1025 nodes up to M = 100, 2049 beyond. Measured
-    # (2026-11-21): |error| ≤ 4 % everywhere except (20, 15): +4.69 %, where the Barus spike is
-    # still sharpening; 5 % bounds that case. (5, 15) converges at +3.99 % (3.3 ph spike).
+    # (2026-11-22): |error| ≤ 4 % everywhere except at L = 15, where Barus gives ᾱ = L √(M/2π)
+    # = 27-85 and every case sits 3-5 % above Moes' fit: (5, 15) +3.99 %, (20, 15) +4.69 %
+    # (+3.28 / +4.31 / +4.69 % on 257 / 513 / 1025 nodes, extrapolated ≈ +4.9 %), (50, 15)
+    # +3.99 %, (100, 15) +2.96 %, (200, 15) +4.27 %. 5 % bounds that row; the issue's 4 % is not met
+    # there (README, known open points). (200, 15) needs the third cold attempt (continuation of
+    # the piezo-viscous exponent on the finest grid): before it, the solve stalled at ‖F‖∞ ≈ 1e-2.
     n = 1025 if m <= 100 else 2049
     s, err = _moes_error(m, l, jg.EHLModel(n_nodes=n, **MOES_PHYSICS))
-    if (m, l) == (200.0, 15.0):
-        # Known open case (issue 3): at 2049 nodes the solve stalls at ‖F‖∞ ≈ 1e-2 (also before the
-        # 2026-11-21 solver changes). It must be reported as not converged with a finite residual,
-        # never as NaN; if it converges, it must meet the bound like the others.
-        if not bool(s.converged):
-            assert np.isfinite(float(s.residual)) and np.all(np.isfinite(np.asarray(s.p)))
-            return
     assert bool(s.converged)
-    assert abs(err) < 0.05, err
+    assert abs(err) < (0.05 if l == 15.0 else 0.04), err
 
 
 def test_rolling_power_identity_incompressible_newtonian():

@@ -718,24 +718,30 @@ def _offset_for_central_film(level: _Level, p, hc):
 
 
 def _schedules(model: EHLModel, dtype):
-    """Continuation schedules of the piezo-viscous exponent s, one row per cold attempt: four
-    plateaus
-    1/4, 1/2, 3/4, 1 first (repeated values cost nothing: Newton stops at once when converged),
-    then,
-    if that failed, ``continuation_steps`` equal steps."""
+    """Continuation schedules of the piezo-viscous exponent s on the coarsest grid, one row per
+    cold attempt: four plateaus 1/4, 1/2, 3/4, 1 first (repeated values cost nothing: Newton stops
+    at once when converged), then, if that failed, ``continuation_steps`` equal steps. The third
+    attempt (smooth and statistical films) follows the second schedule up to
+    ``_FINE_CONTINUATION_START`` only and finishes the continuation on the finest grid."""
     k = model.continuation_steps
     i = np.arange(1, k + 1)
-    return jnp.asarray(np.stack([np.ceil(4.0 * i / k) / 4.0, i / k]), dtype=dtype)
+    return jnp.asarray(np.stack([np.ceil(4.0 * i / k) / 4.0, i / k, i / k]), dtype=dtype)
+
+
+# exponent s at which the third cold attempt reaches the finest grid. Measured (Barus,
+# incompressible, M = 200, L = 15, ᾱ ≈ 85, 2049 nodes): the first two attempts stall at
+# ‖F‖∞ ≈ 1e-2 next to the one-cell pressure spike at the outlet; continuing s = 0.8 → 1 on the
+# finest grid converges (2026-11-22).
+_FINE_CONTINUATION_START = 0.75
 
 
 _INTERMEDIATE_TOLERANCE = 1e-6
 
 
-def _cold_start(model: EHLModel, levels: list[_Level], svals, cubic=False):
+def _cold_start(model: EHLModel, levels: list[_Level], svals, cubic=False, s_end=1.0):
     """Continuation in the piezo-viscous exponent s (schedule ``svals``) on the coarsest grid, then
-    grid
-    sequencing up to the second-finest grid; returns the fine-grid start and the iterations
-    spent."""
+    grid sequencing up to the second-finest grid at exponent ``s_end``; returns the fine-grid start
+    and the iterations spent."""
     coarse = levels[0]
     u = _hertz_start(coarse)
     if len(levels) == 1:
@@ -755,7 +761,7 @@ def _cold_start(model: EHLModel, levels: list[_Level], svals, cubic=False):
     tol = max(model.tolerance, _INTERMEDIATE_TOLERANCE)
     for prev, lev in zip(levels[:-2], levels[1:-1], strict=False):
         u = _transfer(prev, lev, u, cubic)
-        u, _, k, _ = _newton(lev, u, 1.0, model.max_iterations, tol)
+        u, _, k, _ = _newton(lev, u, s_end, model.max_iterations, tol)
         iters = iters + k
     return _transfer(levels[-2], levels[-1], u, cubic), iters
 
@@ -810,7 +816,8 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule; each runs
     # only
     # if everything before it failed (lax.cond: no work when skipped, outside vmap)
-    n_cold = schedules.shape[0]
+    # deterministic mixed films continue in the roughness instead: two cold attempts
+    n_cold = schedules.shape[0] - (1 if mixed == "deterministic" else 0)
     kinds = jnp.asarray(([0] if warm else []) + list(range(1, n_cold + 1)))
     u_warm = _warm_start(fine, init_x, init_p, init_h0) if warm else _hertz_start(fine)
 
@@ -822,12 +829,25 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
             # the coarse grids are built here, inside the branch: a warm start never pays for them
             _, levels = _levels(model, inp)
             if mixed != "deterministic":
-                return _cold_start(model, levels, schedules[row], cubic=row == 0)
+                # third attempt: reach the finest grid at s < 1, continue s → 1 there
+                s_end = jnp.where(row == 2, _FINE_CONTINUATION_START, 1.0).astype(dtype)
+                start, k0 = _cold_start(
+                    model, levels, schedules[row] * s_end, cubic=row == 0, s_end=s_end
+                )
+                return _adaptive_continuation(
+                    model,
+                    lambda r: (fine, s_end + (1.0 - s_end) * r),
+                    start,
+                    k0,
+                    jnp.where(row == 2, 0.0, 1.0).astype(dtype),
+                )
             # mixed: the smooth problem first, then continuation in the roughness amplitude on the
             # fine grid (coarse grids cannot resolve the roughness anyway)
             smooth = [lev.with_roughness(0.0) for lev in levels]
             start, k0 = _cold_start(model, smooth, schedules[row], cubic=row == 0)
-            return _roughness_continuation(model, fine, start, k0)
+            return _adaptive_continuation(
+                model, lambda r: (fine.with_roughness(r), 1.0), start, k0, jnp.zeros((), dtype)
+            )
 
         def keep(_):
             return u, jnp.asarray(0)
@@ -859,17 +879,19 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     return u, res, it.astype(u.dtype), ok.astype(u.dtype)
 
 
-def _roughness_continuation(model: EHLModel, fine: _Level, u, k0):
-    """Adaptive continuation in the roughness amplitude, from the smooth solution ``u`` up to the
-    full roughness (the final solve at full roughness is the caller's).
+def _adaptive_continuation(model: EHLModel, system_at, u, k0, r0):
+    """Adaptive continuation in a parameter r from ``r0`` to 1 on the finest grid; ``system_at(r)``
+    gives (level, s). Nothing runs when r0 = 1. The final solve at r = 1 is the caller's.
 
-    Steps start at 1/``roughness_steps``; each starts from the secant extrapolation of the last two
-    accepted states; a step whose Newton solve fails within half the model's iteration budget is
-    retried at half the increment (down to 1/256 of the first), an accepted one lets the next grow by
-    a third. Measured at the paper's pitch contact (700 N m, 3500 rpm, ground, λ ≈ 0.4): four fixed
+    Used for the roughness amplitude (deterministic mixed film, from the smooth solution) and for
+    the piezo-viscous exponent (third cold attempt of a smooth film). Steps start at
+    1/``roughness_steps``; each starts from the secant extrapolation of the last two accepted
+    states; a step whose Newton solve fails within half the model's iteration budget is retried at
+    half the increment (down to 1/256 of the first), an accepted one lets the next grow by a third.
+    Measured at the paper's pitch contact (700 N m, 3500 rpm, ground, λ ≈ 0.4): four fixed roughness
     steps failed beyond 0.8 of the roughness at 257 nodes and beyond 0.3 at 1025 nodes (residual
-    0.5-4); the accepted steps shrink to ~0.03 at 513 nodes and ~0.015 at 1025 nodes, where asperity
-    contact spreads.
+    0.5-4); the accepted steps shrink to ~0.03 at 513 nodes and ~0.015 at 1025 nodes, where
+    asperity contact spreads.
     """
     dtype = u.dtype
     first = jnp.asarray(1.0 / model.roughness_steps, dtype=dtype)
@@ -886,7 +908,8 @@ def _roughness_continuation(model: EHLModel, fine: _Level, u, k0):
         r_try = jnp.minimum(r + dr, 1.0)
         slope = jnp.where(r > r_prev, (r_try - r) / jnp.maximum(r - r_prev, 1e-12), 0.0)
         guess = u + slope * (u - u_prev)
-        u_new, _, k_new, ok = _newton(fine.with_roughness(r_try), guess, 1.0, budget)
+        level, s = system_at(r_try)
+        u_new, _, k_new, ok = _newton(level, guess, s, budget)
         ok = ok & jnp.all(jnp.isfinite(u_new))
         return (
             jnp.where(ok, u_new, u),
@@ -898,10 +921,10 @@ def _roughness_continuation(model: EHLModel, fine: _Level, u, k0):
             n + 1,
         )
 
-    zero = jnp.asarray(0.0, dtype=dtype)
-    carry = (u, u, zero, zero, first, k0, jnp.asarray(0))
+    r0 = jnp.asarray(r0, dtype=dtype)
+    carry = (u, u, r0, r0, first, k0, jnp.asarray(0))
     u, _, _, _, _, k, _ = jax.lax.while_loop(cond, body, carry)
-    # the last accepted state: the caller's full-roughness solve starts from it
+    # the last accepted state: the caller's solve at r = 1 starts from it
     return u, k
 
 
