@@ -59,6 +59,10 @@ class Fidelity(eqx.Module):
             asperity pressure with the mean film: robust in deep mixed lubrication) or
             "deterministic" (the roughness profiles in the film, unified Reynolds; it needs
             n_nodes ≳ 513 and does not converge in deep mixed lubrication). See EHLModel.mixed.
+        shear: fluid shear law of the EHL rungs (``EHLModel.shear``): "eyring_paper" (the paper's
+            η* = η/cosh(τm/τ0), Eq. 4: the fluid shear stress stays below τ0), "eyring_exact"
+            (τ = τ0 asinh(η us/(τ0 h)): grows without bound, logarithmically) or "newtonian".
+            REFERENCE §4 asks for both Eyring forms and the sensitivity of the loss to the choice.
     """
 
     dynamics: str = _static("tribo_dynamic")
@@ -77,6 +81,7 @@ class Fidelity(eqx.Module):
     backlash: str = _static("exact")
     anderson_memory: int = _static(4)
     mixed_model: str = _static("statistical")
+    shear: str = _static("eyring_paper")
 
     def __check_init__(self):
         _choice("Fidelity.dynamics", self.dynamics, DYNAMICS_RUNGS)
@@ -84,6 +89,7 @@ class Fidelity(eqx.Module):
         _choice("Fidelity.stiffness", self.stiffness, STIFFNESS_METHODS)
         _choice("Fidelity.backlash", self.backlash, ("exact", "smooth"))
         _choice("Fidelity.mixed_model", self.mixed_model, ("statistical", "deterministic"))
+        _choice("Fidelity.shear", self.shear, ("eyring_paper", "eyring_exact", "newtonian"))
         for name in ("thermal", "transient"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"Fidelity.{name} = {getattr(self, name)!r} must be True or False")

@@ -430,6 +430,7 @@ def _solve_contact(repro, result, index, i, slot, label, deterministic=False):
             mixed="deterministic",
             thermal=False,
             boundary_friction=fid.boundary_friction,
+            shear=fid.shear,
         )
         what = (
             f"deterministic roughness, {FIELD_DETERMINISTIC_NODES} nodes, steady, iso-thermal "

@@ -32,6 +32,7 @@ def ehl_model_of(fidelity) -> EHLModel:
         thermal=fidelity.thermal,
         mixed=fidelity.mixed_model,
         boundary_friction=fidelity.boundary_friction,
+        shear=fidelity.shear,
     )
 
 
