@@ -142,7 +142,9 @@ class EHLModel(eqx.Module):
         max_iterations: Newton iterations per grid level (and per continuation step).
         coarsest_nodes: smallest grid of the sequence.
         continuation_steps: steps of the piezo-viscous exponent (s = 1/n … 1) on the coarsest grid
-            in the second cold attempt (the first uses s = 1/4, 1/2, 3/4, 1).
+            in the second cold attempt (the first uses s = 1/4, 1/2, 3/4, 1). From 1025 nodes on, a
+            third attempt (smooth and statistical films) takes those steps up to s = 0.75, sequences
+            to the finest grid there and continues s → 1 on it adaptively.
         warm_iterations: Newton iterations allowed for a warm start before falling back to a cold
         solve.
         deformation: "dense", "fft" (DC-FFT for residuals; the Jacobian stays dense), "auto" (fft
@@ -733,6 +735,7 @@ def _schedules(model: EHLModel, dtype):
 # ‖F‖∞ ≈ 1e-2 next to the one-cell pressure spike at the outlet; continuing s = 0.8 → 1 on the
 # finest grid converges (2026-11-22).
 _FINE_CONTINUATION_START = 0.75
+_FINE_CONTINUATION_NODES = 1025  # grids from this size on get the third attempt
 
 
 _INTERMEDIATE_TOLERANCE = 1e-6
@@ -816,8 +819,11 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule; each runs
     # only
     # if everything before it failed (lax.cond: no work when skipped, outside vmap)
-    # deterministic mixed films continue in the roughness instead: two cold attempts
-    n_cold = schedules.shape[0] - (1 if mixed == "deterministic" else 0)
+    # the third attempt only on fine grids, where the one-cell spike trap arises (under vmap a
+    # skipped attempt still runs, so coarser grids do not pay for it); deterministic mixed films
+    # continue in the roughness instead
+    third = mixed != "deterministic" and model.n_nodes >= _FINE_CONTINUATION_NODES
+    n_cold = schedules.shape[0] - (0 if third else 1)
     kinds = jnp.asarray(([0] if warm else []) + list(range(1, n_cold + 1)))
     u_warm = _warm_start(fine, init_x, init_p, init_h0) if warm else _hertz_start(fine)
 
@@ -828,6 +834,8 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
             row = jnp.clip(kind - 1, 0, n_cold - 1)
             # the coarse grids are built here, inside the branch: a warm start never pays for them
             _, levels = _levels(model, inp)
+            if mixed != "deterministic" and not third:
+                return _cold_start(model, levels, schedules[row], cubic=row == 0)
             if mixed != "deterministic":
                 # third attempt: reach the finest grid at s < 1, continue s → 1 there
                 s_end = jnp.where(row == 2, _FINE_CONTINUATION_START, 1.0).astype(dtype)
