@@ -166,7 +166,9 @@ class EHLModel(eqx.Module):
             solve continues adaptively in the roughness amplitude from the smooth film. Measured
             with ``presets.ground()`` at the paper's pitch contact: converges at 3500 rpm
             (λ ≈ 0.4) on 257-1025 nodes; at 500 rpm (λ ≈ 0.1) on 257 nodes but not on 1025, where
-            the continuation stalls at 0.43 of the roughness (reported as not converged).
+            the continuation stalls at 0.43 of the roughness (reported as not converged). A
+            continuation that accepted at least one step and then failed is not repeated by a
+            second cold attempt (it would start from the same smooth film and take the same path).
             "statistical": the mean film with the Greenwood-Tripp asperity pressure p_a(h)
             (``asperity.py``) added to the load and the deformation (Johnson-Greenwood-Poon load
             sharing), iterated with the temperatures; robust down to λ → 0; it needs only the
@@ -817,64 +819,71 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     dtype = fine.x.dtype
     schedules = _schedules(model, dtype)
     # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule; each runs
-    # only
-    # if everything before it failed (lax.cond: no work when skipped, outside vmap)
-    # the third attempt only on fine grids, where the one-cell spike trap arises (under vmap a
-    # skipped attempt still runs, so coarser grids do not pay for it); deterministic mixed films
-    # continue in the roughness instead
+    # only if everything before it failed (lax.cond: no work when skipped, outside vmap). The third
+    # attempt only on fine grids, where the one-cell spike trap arises (under vmap a skipped attempt
+    # still runs, so coarser grids do not pay for it); deterministic mixed films continue in the
+    # roughness instead, and stop after a failed continuation that got under way
     third = mixed != "deterministic" and model.n_nodes >= _FINE_CONTINUATION_NODES
     n_cold = schedules.shape[0] - (0 if third else 1)
     kinds = jnp.asarray(([0] if warm else []) + list(range(1, n_cold + 1)))
     u_warm = _warm_start(fine, init_x, init_p, init_h0) if warm else _hertz_start(fine)
+    false = jnp.asarray(False)
 
     def attempt(carry, kind):
-        u, res, it, ok = carry
+        u, res, it, ok, stop = carry
 
         def cold(_):
             row = jnp.clip(kind - 1, 0, n_cold - 1)
             # the coarse grids are built here, inside the branch: a warm start never pays for them
             _, levels = _levels(model, inp)
             if mixed != "deterministic" and not third:
-                return _cold_start(model, levels, schedules[row], cubic=row == 0)
+                return (*_cold_start(model, levels, schedules[row], cubic=row == 0), false)
             if mixed != "deterministic":
                 # third attempt: reach the finest grid at s < 1, continue s → 1 there
                 s_end = jnp.where(row == 2, _FINE_CONTINUATION_START, 1.0).astype(dtype)
                 start, k0 = _cold_start(
                     model, levels, schedules[row] * s_end, cubic=row == 0, s_end=s_end
                 )
-                return _adaptive_continuation(
+                start, k0, _ = _adaptive_continuation(
                     model,
                     lambda r: (fine, s_end + (1.0 - s_end) * r),
                     start,
                     k0,
                     jnp.where(row == 2, 0.0, 1.0).astype(dtype),
                 )
+                return start, k0, false
             # mixed: the smooth problem first, then continuation in the roughness amplitude on the
             # fine grid (coarse grids cannot resolve the roughness anyway)
             smooth = [lev.with_roughness(0.0) for lev in levels]
             start, k0 = _cold_start(model, smooth, schedules[row], cubic=row == 0)
-            return _adaptive_continuation(
+            start, k0, reached = _adaptive_continuation(
                 model, lambda r: (fine.with_roughness(r), 1.0), start, k0, jnp.zeros((), dtype)
             )
+            # once a roughness step has been accepted, the smooth start was good: if this attempt
+            # fails, the next would repeat the same continuation from the same smooth film
+            # (measured: a more patient continuation, 16 first steps and twice the Newton budget,
+            # stalls as well at 500 rpm on 1025 nodes), so it is not run
+            return start, k0, reached > 0.0
 
         def keep(_):
-            return u, jnp.asarray(0)
+            return u, jnp.asarray(0), false
 
-        start, k0 = jax.lax.cond(ok | (kind == 0), keep, cold, None)
+        done = ok | stop
+        start, k0, repeat = jax.lax.cond(done | (kind == 0), keep, cold, None)
         start = jnp.where(kind == 0, u_warm, start)
         budget = model.warm_iterations if warm else model.max_iterations
-        max_iter = jnp.where(ok, 0, jnp.where(kind == 0, budget, model.max_iterations))
+        max_iter = jnp.where(done, 0, jnp.where(kind == 0, budget, model.max_iterations))
         u1, res1, k1, ok1 = _newton(fine, start, 1.0, max_iter)
-        u1 = jnp.where(ok, u, u1)
-        res1 = jnp.where(ok, res, res1)
+        u1 = jnp.where(done, u, u1)
+        res1 = jnp.where(done, res, res1)
         # smooth EHL: a closed film is a failure: try the next attempt (mixed: it is contact)
         ok1 = ok | ok1
         if mixed == "smooth":
             ok1 = ok1 & (jnp.min(fine.film(u1)) > 0.0)
-        return (u1, res1, it + k0 + k1, ok1), None
+        return (u1, res1, it + k0 + k1, ok1, stop | repeat), None
 
-    init = (u_warm, jnp.asarray(jnp.inf, dtype=dtype), jnp.asarray(0), jnp.asarray(False))
-    (u, res, it, ok), _ = jax.lax.scan(attempt, init, kinds)
+    init = (u_warm, jnp.asarray(jnp.inf, dtype=dtype), jnp.asarray(0), false, false)
+    (u, res, it, ok, _), _ = jax.lax.scan(attempt, init, kinds)
     # a closed (non-positive) film is not a smooth-EHL solution, however small the residual: report
     # it
     if mixed == "smooth":
@@ -889,7 +898,8 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
 
 def _adaptive_continuation(model: EHLModel, system_at, u, k0, r0):
     """Adaptive continuation in a parameter r from ``r0`` to 1 on the finest grid; ``system_at(r)``
-    gives (level, s). Nothing runs when r0 = 1. The final solve at r = 1 is the caller's.
+    gives (level, s). Nothing runs when r0 = 1. The final solve at r = 1 is the caller's. Returns
+    the last accepted state, the iterations and the r it reached.
 
     Used for the roughness amplitude (deterministic mixed film, from the smooth solution) and for
     the piezo-viscous exponent (third cold attempt of a smooth film). Steps start at
@@ -931,9 +941,9 @@ def _adaptive_continuation(model: EHLModel, system_at, u, k0, r0):
 
     r0 = jnp.asarray(r0, dtype=dtype)
     carry = (u, u, r0, r0, first, k0, jnp.asarray(0))
-    u, _, _, _, _, k, _ = jax.lax.while_loop(cond, body, carry)
+    u, _, r, _, _, k, _ = jax.lax.while_loop(cond, body, carry)
     # the last accepted state: the caller's solve at r = 1 starts from it
-    return u, k
+    return u, k, r
 
 
 @_solve_core.defjvp
