@@ -33,6 +33,8 @@ def ehl_model_of(fidelity) -> EHLModel:
         mixed=fidelity.mixed_model,
         boundary_friction=fidelity.boundary_friction,
         shear=fidelity.shear,
+        asperity_density_product=fidelity.asperity_density_product,
+        asperity_slope_ratio=fidelity.asperity_slope_ratio,
     )
 
 
