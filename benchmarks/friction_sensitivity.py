@@ -8,13 +8,16 @@ the Greenwood-Tripp nβσ and σ/β (``Fidelity.asperity_density_product``, ``as
 0.05, 0.01) and the boundary friction μb (``Fidelity.boundary_friction``; the paper's 0.1). This
 runs the quasi-static paper fidelity (thermal, statistical mixed, transient; 32 positions × 257
 nodes) at the nominal speeds of the points A, B, D, E, varying one parameter at a time from the
-defaults, and writes its section of RESULTS.md. No default is changed: a sensitivity study.
+defaults, then the tribo-dynamic paper fidelity at the default nβσ and at 0.08 (the value the
+quasi-static sweep finds reaching the paper), and writes its section of RESULTS.md. No default is
+changed: a sensitivity study.
 
 Run: ``python benchmarks/friction_sensitivity.py [--quick] [--fresh]`` (``--quick``: points B and
 E only; ``--fresh``: discard the cached rows). Each new static configuration (nβσ, σ/β, μb) is a
 new compilation of about 60-90 s, and LLVM may run out of memory after many compilations in one
 process, so each group of variants runs in its own process (``--group NAME``, also usable by hand)
-and caches its rows in ``CACHE``; a rerun resumes from it. Full: about 15 min on 2 cores.
+and caches its rows in ``CACHE``; a rerun resumes from it. Full: about 15 min on 2 cores for the
+quasi-static sweep, 10 min more for the tribo-dynamic group.
 """
 
 from __future__ import annotations
@@ -37,7 +40,11 @@ jax.config.update("jax_enable_x64", True)
 from _report import machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear.figures import NOMINAL_POINTS_RPM, PAPER_QUASI_STATIC_W  # noqa: E402
+from jaxgear.figures import (  # noqa: E402
+    NOMINAL_POINTS_RPM,
+    PAPER_QUASI_STATIC_W,
+    PAPER_TRIBO_DYNAMIC_W,
+)
 
 PAIR = jg.presets.li2015_pair_calibrated()
 LUB = jg.presets.mil_l_23699()
@@ -58,6 +65,7 @@ GROUPS = {
     "density": ("asperity_density_product",),
     "slope": ("asperity_slope_ratio",),
     "boundary": ("boundary_friction",),
+    "tribo_dynamic": (),
 }
 
 
@@ -86,8 +94,59 @@ def _save_row(key, row):
     CACHE.write_text(json.dumps(cache, indent=1))
 
 
+# the tribo-dynamic check: the paper fidelity as it is (defaults) and with nβσ at the value the
+# quasi-static sweep says reaches the paper's loss
+TRIBO_DYNAMIC_DENSITY = (0.05, 0.08)
+
+
+def _row(r, dt, **extra):
+    sliding = float(r.power_loss_sliding)
+    us = r.surface_velocity[..., 0] - r.surface_velocity[..., 1]
+    work = float(jnp.mean(jnp.sum(jnp.abs(r.tooth_force * us), axis=1)))
+    return dict(
+        total=float(r.power_loss),
+        sliding=sliding,
+        rolling=float(r.power_loss_rolling),
+        mu=sliding / max(work, 1e-30),
+        status=int(r.status),
+        time=dt,
+        load=os.getloadavg()[0],  # the timings mean little on a loaded machine
+        **extra,
+    )
+
+
+def _simulate(lub, fid, name):
+    """One point: the result and its wall time (compilation included on a first call)."""
+    op = jg.OperatingPoint(700.0, NOMINAL_POINTS_RPM[name], 363.15)
+    t0 = time.perf_counter()
+    r = jg.simulate(PAIR, lub, SURF, op, fidelity=fid)
+    jax.block_until_ready(r.power_loss)
+    return r, time.perf_counter() - t0
+
+
+def run_tribo_dynamic(points) -> None:
+    """Fidelity.paper() (tribo-dynamic) at the defaults and at nβσ = 0.08, against the paper's
+    tribo-dynamic losses (R2) and its tribo-dynamic/quasi-static ordering (R3)."""
+    cache = _load_cache()
+    for density in TRIBO_DYNAMIC_DENSITY:
+        fid = jg.Fidelity.paper(asperity_density_product=density)
+        first = True
+        for name in points:
+            key = f"td/nbs={density:g}/{name}"
+            if key in cache:
+                continue
+            r, dt = _simulate(LUB, fid, name)
+            row = _row(r, dt, density=density, point=name, compiled=first)
+            first = False
+            _save_row(key, row)
+            print("td", density, name, f"{row['total']:.1f} W", row["status"], flush=True)
+
+
 def run_group(group: str, points) -> None:
     """Run the variants of ``group`` at ``points`` that are not yet in the cache."""
+    if group == "tribo_dynamic":
+        run_tribo_dynamic(points)
+        return
     cache = _load_cache()
     compiled = set()  # the static configurations compiled in this process
     for param, value in _variants(GROUPS[group]):
@@ -101,26 +160,14 @@ def run_group(group: str, points) -> None:
             key = _key(param or "default", value or 0.0, name)
             if key in cache:
                 continue
-            op = jg.OperatingPoint(700.0, NOMINAL_POINTS_RPM[name], 363.15)
-            t0 = time.perf_counter()
-            r = jg.simulate(PAIR, lub, SURF, op, fidelity=fid)
-            jax.block_until_ready(r.power_loss)
-            dt = time.perf_counter() - t0
-            sliding = float(r.power_loss_sliding)
-            us = r.surface_velocity[..., 0] - r.surface_velocity[..., 1]
-            work = float(jnp.mean(jnp.sum(jnp.abs(r.tooth_force * us), axis=1)))
-            row = dict(
+            r, dt = _simulate(lub, fid, name)
+            row = _row(
+                r,
+                dt,
                 param=param or "default",
                 value=value,
                 point=name,
-                total=float(r.power_loss),
-                sliding=sliding,
-                rolling=float(r.power_loss_rolling),
-                mu=sliding / max(work, 1e-30),
-                status=int(r.status),
-                time=dt,
-                compiled=fid not in compiled,  # this run includes the compilation
-                load=os.getloadavg()[0],  # the timings mean little on a loaded machine
+                compiled=fid not in compiled,
             )
             compiled.add(fid)
             _save_row(key, row)
@@ -242,7 +289,8 @@ def _reading(rows, points) -> list[str]:
 
 def write_results(points) -> None:
     cache = _load_cache()
-    rows = [r for r in cache.values() if r["point"] in points]
+    td = {k: r for k, r in cache.items() if k.startswith("td/") and r["point"] in points}
+    rows = [r for k, r in cache.items() if not k.startswith("td/") and r["point"] in points]
     order = {"default": 0, **{p: i + 1 for i, p in enumerate(PARAMETERS)}}
     rows.sort(key=lambda r: (order[r["param"]], r["value"] or 0.0, "ABCDE".index(r["point"])))
     lines = [
@@ -282,8 +330,43 @@ def write_results(points) -> None:
         "Status: 0 ok, 1 fixed point, 2 dynamics, 3 a contact solve, 4 non-finite." + load_note,
         "",
         *_reading(rows, points),
+        *_tribo_dynamic_table(td, rows),
     ]
     write_section("friction_sensitivity", "\n".join(lines))
+
+
+def _tribo_dynamic_table(td, rows) -> list[str]:
+    """The tribo-dynamic rows beside the paper (R2) and the TD/QS ordering (R3)."""
+    if not td:
+        return []
+    qs = {}
+    for r in rows:
+        if r["param"] == "default":
+            qs[(0.05, r["point"])] = r["total"]
+        elif r["param"] == "asperity_density_product":
+            qs[(r["value"], r["point"])] = r["total"]
+    lines = [
+        "",
+        "Tribo-dynamic: `Fidelity.paper()` (all of the above, tribo-dynamic) at the default nβσ and "
+        "at 0.08, against the paper's tribo-dynamic loss (R2) and its ordering against the "
+        "quasi-static loss of the same nβσ (R3: TD below QS at A and D, above at B and E).",
+        "",
+        "| nβσ | point | rpm | TD Φ̄ (W) | paper TD (W) | TD/paper | QS Φ̄ (W) | TD vs QS | paper | "
+        "μ_eff | status | time (s) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    paper_order = {"A": "below", "B": "above", "C": "equal", "D": "below", "E": "above"}
+    for r in sorted(td.values(), key=lambda r: (r["density"], "ABCDE".index(r["point"]))):
+        p, paper = r["point"], PAPER_TRIBO_DYNAMIC_W[r["point"]]
+        q = qs.get((r["density"], p))
+        order = "–" if q is None else ("above" if r["total"] > q else "below")
+        lines.append(
+            f"| {r['density']:g} | {p} | {NOMINAL_POINTS_RPM[p]:.0f} | {r['total']:.1f} | "
+            f"{paper:.0f} | {r['total'] / paper:.2f} | {'–' if q is None else f'{q:.1f}'} | "
+            f"{order} | {paper_order[p]} | {r['mu']:.4f} | {r['status']} | "
+            f"{r['time']:.1f}{'*' if r['compiled'] else ''} |"
+        )
+    return lines
 
 
 def main():
