@@ -58,3 +58,13 @@ def write_section(name: str, body: str) -> None:
         else text.rstrip() + "\n\n" + block + "\n"
     )
     RESULTS.write_text(text)
+
+
+def effective_friction(result) -> float:
+    """μ_eff of a SimulationResult: its sliding loss over the cycle mean of Σ W |us| (the mean
+    friction coefficient the loss implies; REFERENCE §6)."""
+    import jax.numpy as jnp
+
+    us = result.surface_velocity[..., 0] - result.surface_velocity[..., 1]
+    work = float(jnp.mean(jnp.sum(jnp.abs(result.tooth_force * us), axis=1)))
+    return float(result.power_loss_sliding) / max(work, 1e-30)

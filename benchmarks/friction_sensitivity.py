@@ -33,11 +33,10 @@ import time
 from pathlib import Path
 
 import jax
-import jax.numpy as jnp
 
 jax.config.update("jax_enable_x64", True)
 
-from _report import machine, write_section  # noqa: E402
+from _report import effective_friction, machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 from jaxgear.figures import (  # noqa: E402
@@ -101,13 +100,11 @@ TRIBO_DYNAMIC_DENSITY = (0.05, 0.08)
 
 def _row(r, dt, **extra):
     sliding = float(r.power_loss_sliding)
-    us = r.surface_velocity[..., 0] - r.surface_velocity[..., 1]
-    work = float(jnp.mean(jnp.sum(jnp.abs(r.tooth_force * us), axis=1)))
     return dict(
         total=float(r.power_loss),
         sliding=sliding,
         rolling=float(r.power_loss_rolling),
-        mu=sliding / max(work, 1e-30),
+        mu=effective_friction(r),
         status=int(r.status),
         time=dt,
         load=os.getloadavg()[0],  # the timings mean little on a loaded machine

@@ -16,11 +16,10 @@ import sys
 import time
 
 import jax
-import jax.numpy as jnp
 
 jax.config.update("jax_enable_x64", True)
 
-from _report import machine, write_section  # noqa: E402
+from _report import effective_friction, machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 from jaxgear.figures import (  # noqa: E402
@@ -52,9 +51,7 @@ def main(quick: bool = False):
                 t_first = dt if t_first is None else t_first
                 sliding = float(r.power_loss_sliding)
                 total = float(r.power_loss)
-                us = r.surface_velocity[..., 0] - r.surface_velocity[..., 1]
-                work = float(jnp.mean(jnp.sum(jnp.abs(r.tooth_force * us), axis=1)))
-                mu = sliding / max(work, 1e-30)
+                mu = effective_friction(r)
                 rows.append((dyn, shear, name, total, sliding, mu, int(r.status), dt))
                 print(
                     dyn,
