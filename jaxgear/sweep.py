@@ -20,7 +20,7 @@ from .fidelity import Fidelity
 from .operating import OperatingPoint
 from .sweep_engine import STATUS_NAMES as POINT_STATUS_NAMES
 from .sweep_engine import run_continuation, run_points
-from .tribodynamics import STATUS_NAMES, check_inputs, simulate_with_state
+from .tribodynamics import STATUS_NAMES, check_inputs, cold_start, simulate_with_state
 
 #: Inputs a sweep may vary, besides the speed.
 SWEEPABLE = (
@@ -163,9 +163,6 @@ def _step(warm, point, shared):
     return carry, _outputs(result)
 
 
-_first_state = eqx.filter_jit(simulate_with_state)
-
-
 def sweep(
     pair,
     lubricant,
@@ -260,9 +257,8 @@ def sweep(
             sequential=fidelity.uses_ehl,
         )
     else:
-        first = jax.tree_util.tree_map(lambda x: jnp.asarray(x[0]), inputs)
-        p0, s0, o0 = _apply(pair, surfaces, op, first)
-        _, warm0 = _first_state(p0, lubricant, s0, o0, fidelity)
+        # the first point starts cold through the same compiled step as the rest
+        warm0 = cold_start(fidelity.n_positions, jnp.asarray(op.torque).dtype)
         raw = run_continuation(
             _step,
             warm0,

@@ -362,10 +362,10 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
 
     zeros = jnp.zeros((m, 2), dtype=op.torque.dtype)
     if warm is None:
-        interface0 = MeshInterface(damping=zeros, friction_1=zeros, friction_2=zeros)
-        guess0, started0 = jnp.zeros(13, dtype=zeros.dtype), 0.0
-    else:  # continuation: the neighbouring point's converged interface and orbit
-        interface0, guess0, started0 = warm.interface, warm.orbit, 1.0
+        warm = cold_start(m, zeros.dtype)
+    # continuation: the neighbouring point's converged interface and orbit (a cold WarmStart has
+    # zero tables and started = 0, which makes this the cold path, traced the same way)
+    interface0, guess0, started0 = warm.interface, warm.orbit, warm.started
     velocity0 = kinematic_velocities(pair, mesh, op.omega1)
     # EHL rungs: cold solves at the quasi-static state, then every iteration warm-starts from the last
     # (one cold and one warm trace of the solver); formula rungs carry no contact state.
@@ -454,14 +454,29 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         residual,
         sol.stats["num_steps"],
     )
-    return result, WarmStart(interface=state["interface"], orbit=state["guess"])
+    return result, WarmStart(
+        interface=state["interface"], orbit=state["guess"], started=state["started"]
+    )
 
 
 class WarmStart(eqx.Module):
-    """A converged tribo-dynamic state to start a neighbouring point from (continuation sweeps)."""
+    """A converged tribo-dynamic state to start a neighbouring point from (continuation sweeps).
+
+    ``started`` is 1 when ``orbit`` is a periodic orbit to shoot from, 0 for a cold start
+    (``cold_start``): then the orbit is ignored and the tables are zero."""
 
     interface: MeshInterface
     orbit: Float[Array, " 13"]
+    started: Float[Array, ""]
+
+
+def cold_start(n_positions: int, dtype=jnp.float64) -> WarmStart:
+    """The WarmStart equivalent to no warm start: a continuation sweep's first point runs through the
+    same compiled step as the others (one compilation instead of two)."""
+    zeros = jnp.zeros((n_positions, 2), dtype=dtype)
+    return WarmStart(
+        MeshInterface(zeros, zeros, zeros), jnp.zeros(13, dtype=dtype), jnp.zeros((), dtype=dtype)
+    )
 
 
 def simulate_with_state(pair, lubricant, surfaces, op, fidelity, warm: WarmStart | None = None):
@@ -471,8 +486,7 @@ def simulate_with_state(pair, lubricant, surfaces, op, fidelity, warm: WarmStart
     """
     mesh = mesh_cycle(pair, op.torque, fidelity.n_positions, stiffness=fidelity.stiffness)
     if fidelity.dynamics == "quasi_static":
-        zeros = jnp.zeros((fidelity.n_positions, 2), dtype=op.torque.dtype)
-        none = WarmStart(MeshInterface(zeros, zeros, zeros), jnp.zeros(13, dtype=zeros.dtype))
+        none = cold_start(fidelity.n_positions, op.torque.dtype)
         return _quasi_static(pair, lubricant, surfaces, op, fidelity, mesh), none
     return _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm)
 
