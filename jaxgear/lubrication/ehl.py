@@ -490,7 +490,9 @@ class _Level(eqx.Module):
     def deformation(self, p):
         if self.model.use_fft(self.n):
             return deformation_mod.deformation_fft(p, self.spacing)
-        return self.kernel_rows[2 : self.n + 2] @ p
+        # the whole padded matrix times p, then the rows wanted: slicing the matrix first would copy
+        # it (XLA does not fuse a slice into a dot operand)
+        return (self.kernel_rows @ p)[2 : self.n + 2]
 
     def film(self, u):
         p, h0 = u[: self.n], u[self.n]
@@ -554,10 +556,14 @@ class _Level(eqx.Module):
         # J[i, j] = Σ_k dP_k[i] [j = i + k] + Σ_k dH_k[i] D[i + k, j]: the shifted influence rows
         # are slices of the level's padded matrix (built once per solve, outside the Newton loop),
         # so the assembly is one fused elementwise pass over n² entries, with no gathers
-        m = rows[:, None] - rows[None, :]
+        # the barrier ties the influence rows to this Newton iterate: otherwise XLA hoists the four
+        # n × n slices (and masks) out of the Newton while-loop as loop invariants, materialising
+        # them before every solve even when it takes no iteration (15 ms at N = 1025, measured)
+        kernel_rows, rows_b, _ = jax.lax.optimization_barrier((self.kernel_rows, rows, u))
+        m = rows_b[:, None] - rows_b[None, :]
         dense = jnp.zeros((n, n), dtype=p.dtype)
         for k, dp, dh in zip(offsets, dps, dhs, strict=True):
-            shifted = self.kernel_rows[k + 2 : k + 2 + n]
+            shifted = kernel_rows[k + 2 : k + 2 + n]
             dense = dense + dh[:, None] * shifted + jnp.where(m == -k, dp[:, None], 0.0)
         h0_col = sum(dhs)
         top = jnp.concatenate([dense, h0_col[:, None]], axis=1)
@@ -605,18 +611,10 @@ _MIXED_PRECISION_NODES = 513  # from this size on, the LU of the Newton matrix i
 _DIRECTION_TOLERANCE = 1e-3  # accepted relative residual ‖J d + F‖/‖F‖ of a mixed-precision step
 
 
-def _newton_direction(jac, f):
-    """Newton direction d = −J⁻¹F.
-
-    On large grids the dense LU dominates the cost (≈ 30 ms at N = 1025); there it is factorised in
-    single precision (half the time) and the direction refined twice against the float64 matrix
-    (cond J ≈ 1e6 at high load: each refinement gains ~cond·ε32 ≈ 0.1). A direction still off by
-    more than ``_DIRECTION_TOLERANCE`` is recomputed in double precision. The convergence test
-    stays on the float64 residual, so only the path to the solution changes, not the solution."""
-    n = jac.shape[0]
-    if n < _MIXED_PRECISION_NODES:
-        return jnp.linalg.solve(jac, -f)
-    lu = jax.scipy.linalg.lu_factor(jac.astype(jnp.float32))
+def _refined(jac, f, lu):
+    """Direction −J⁻¹F from a single-precision LU ``lu`` (of J or of a nearby matrix), refined twice
+    against the float64 J, and whether its relative residual ‖J d + F‖/‖F‖ is acceptable
+    (NaN-safe: a non-finite direction is not)."""
 
     def solve32(r):
         return jax.scipy.linalg.lu_solve(lu, r.astype(jnp.float32)).astype(jac.dtype)
@@ -624,10 +622,32 @@ def _newton_direction(jac, f):
     d = solve32(-f)
     for _ in range(2):
         d = d + solve32(-f - jac @ d)
-    bad = ~(
-        jnp.linalg.norm(jac @ d + f) <= _DIRECTION_TOLERANCE * jnp.linalg.norm(f)
-    )  # NaN-safe: a non-finite direction is bad
-    return jax.lax.cond(bad, lambda: jnp.linalg.solve(jac, -f), lambda: d)
+    good = jnp.linalg.norm(jac @ d + f) <= _DIRECTION_TOLERANCE * jnp.linalg.norm(f)
+    return d, good
+
+
+def _newton_direction(jac, f, lu_prev):
+    """Newton direction d = −J⁻¹F, and the single-precision LU it used (None below 513 nodes).
+
+    On large grids the dense LU dominates the cost (≈ 12-20 ms at N = 1025); there it is factorised
+    in single precision and the direction refined twice against the float64 matrix (cond J ≈ 1e6 at
+    high load: each refinement gains ~cond·ε32 ≈ 0.1). The previous iteration's LU (``lu_prev``) is
+    tried first: near convergence J changes little and the refinement absorbs the difference, so no
+    new factorisation is needed. A direction off by more than ``_DIRECTION_TOLERANCE`` is recomputed
+    from a fresh LU, and if still off, in double precision. The convergence test stays on the
+    float64 residual, so only the path to the solution changes, not the solution."""
+    n = jac.shape[0]
+    if n < _MIXED_PRECISION_NODES:
+        return jnp.linalg.solve(jac, -f), None
+
+    def fresh(_):
+        lu = jax.scipy.linalg.lu_factor(jac.astype(jnp.float32))
+        d, good = _refined(jac, f, lu)
+        d = jax.lax.cond(good, lambda: d, lambda: jnp.linalg.solve(jac, -f))
+        return d, lu
+
+    d, good = _refined(jac, f, lu_prev)
+    return jax.lax.cond(good, lambda _: (d, lu_prev), fresh, None)
 
 
 def _newton(level: _Level, u0, s, max_iter: int, tol=None):
@@ -641,15 +661,21 @@ def _newton(level: _Level, u0, s, max_iter: int, tol=None):
         return f, jnp.where(jnp.isfinite(m), m, jnp.inf)
 
     f0, m0 = merit(u0)
+    # large grids carry the last single-precision LU from one iteration to the next (a chord step
+    # when it still gives an accurate direction); the first iteration starts from a zero "LU",
+    # whose non-finite direction fails the accuracy test, so it factorises
+    n1 = u0.shape[0]
+    reuse = n1 >= _MIXED_PRECISION_NODES
+    lu0 = (jnp.zeros((n1, n1), jnp.float32), jnp.arange(n1, dtype=jnp.int32)) if reuse else None
 
     def cond(state):
-        u, f, m, it, stop = state
+        u, f, m, it, stop, _ = state
         return (~stop) & (it < max_iter)
 
     def body(state):
-        u, f, m, it, _ = state
+        u, f, m, it, _, lu = state
         jac = level.jacobian(u, s)
-        d = _newton_direction(jac, f)
+        d, lu = _newton_direction(jac, f, lu)
         d = jnp.where(jnp.isfinite(d), d, 0.0)
         # cap the film-offset change per step: a runaway H0 is the usual way a far start diverges
         cap = 0.5 * jnp.maximum(jnp.abs(u[-1]), 10.0 * level.sc.h_ref)
@@ -677,10 +703,10 @@ def _newton(level: _Level, u0, s, max_iter: int, tol=None):
         m_new = jnp.where(ok, m_new, m)
         done = _norm_inf(f_new) < tol
         stalled = (~ok) | (alpha * _norm_inf(d) < 1e-15)
-        return u_new, f_new, m_new, it + 1, done | stalled
+        return u_new, f_new, m_new, it + 1, done | stalled, lu
 
-    init = (u0, f0, m0, jnp.asarray(0), _norm_inf(f0) < tol)
-    u, f, m, it, _ = jax.lax.while_loop(cond, body, init)
+    init = (u0, f0, m0, jnp.asarray(0), _norm_inf(f0) < tol, lu0)
+    u, f, m, it, _, _ = jax.lax.while_loop(cond, body, init)
     res = _norm_inf(f)
     return u, res, it, res < tol
 
