@@ -257,7 +257,7 @@ def check_top_level(cfg: dict[str, Any], allowed: tuple[str, ...]) -> None:
 SWEEP_TABLES = ("gear", "lubricant", "surfaces", "operating", "fidelity", "sweep")
 LUBRICANT_PRESETS = ("mil_l_23699", "iso_vg68")
 SURFACE_PRESETS = ("ground", "polished", "smooth")
-FIDELITY_PRESETS = ("fast", "paper")
+FIDELITY_PRESETS = ("fast", "paper", "auto")
 _SURFACE_KEYS = {
     "preset": str,
     "scale": float,
@@ -303,6 +303,7 @@ class SweepConfig:
     quasi_static_reference: bool
     progress: bool
     echo: dict
+    fidelity_reasons: str | None = None
 
 
 def _lubricant_keys() -> dict:
@@ -382,7 +383,7 @@ def surfaces_from_config(cfg: dict[str, Any]):
 def _fidelity_keys() -> dict:
     from .fidelity import Fidelity
 
-    keys: dict[str, Any] = {"preset": str}
+    keys: dict[str, Any] = {"preset": str, "tolerance": float}
     for f in dataclasses.fields(Fidelity):
         # a None default (fixed_point_tolerance: chosen by the rung) is given as a number or left out
         kind = float if f.default is None else type(f.default)
@@ -391,10 +392,16 @@ def _fidelity_keys() -> dict:
 
 
 def fidelity_from_config(cfg: dict[str, Any], preset: str | None = None):
-    """``[fidelity]``: ``preset`` ("fast" or "paper"; ``preset`` given here, e.g. from the command
-    line, wins) and any ``jg.Fidelity`` field to override (``n_positions = 24``,
-    ``dynamics = "quasi_static"``...)."""
+    """``[fidelity]``: ``preset`` ("fast", "paper" or "auto"; ``preset`` given here, e.g. from the
+    command line, wins) and any ``jg.Fidelity`` field to override (``n_positions = 24``,
+    ``dynamics = "quasi_static"``...).
+
+    Returns (Fidelity, echo). With preset "auto" the Fidelity is the *base* of the choice: its
+    ladder fields (physics axes and resolution) must be left out, since ``Fidelity.auto`` sets
+    them; ``tolerance`` (default 0.05) is the choice's tolerance and the caller makes the choice
+    (it needs the scenario: see ``sweep_from_config``)."""
     from .fidelity import Fidelity
+    from .fidelity_auto import LADDER_FIELDS
 
     table = dict(cfg.get("fidelity", {}))
     check_keys(table, _fidelity_keys(), "fidelity")
@@ -405,11 +412,31 @@ def fidelity_from_config(cfg: dict[str, Any], preset: str | None = None):
             f"fidelity preset = {name!r} is not valid; valid choices: "
             + ", ".join(map(repr, FIDELITY_PRESETS))
         )
+    echo = {"preset": name, **table}
+    tolerance = table.pop("tolerance", None)
+    if name == "auto":
+        chosen_here = sorted(set(table) & set(LADDER_FIELDS))
+        if chosen_here:
+            raise ValueError(
+                f"fidelity.{chosen_here[0]} is chosen by preset = 'auto'; remove it, or give "
+                "preset 'fast' or 'paper' to set it"
+            )
+        tolerance = 0.05 if tolerance is None else tolerance
+        if not 0.0 < tolerance < 1.0:
+            raise ValueError(
+                f"fidelity.tolerance = {tolerance!r} is out of range; valid range: (0, 1)"
+            )
+        echo["tolerance"] = tolerance
+    elif tolerance is not None:
+        raise ValueError(
+            f"fidelity.tolerance has no meaning with preset = {name!r}; it is the tolerance of "
+            "preset = 'auto'"
+        )
     try:
-        fid = Fidelity.named(name, **table)
+        fid = Fidelity(**table) if name == "auto" else Fidelity.named(name, **table)
     except ValueError as err:
         raise ValueError(str(err).replace("Fidelity.", "fidelity.")) from None
-    return fid, {"preset": name, **table}
+    return fid, echo
 
 
 def _speeds(table) -> np.ndarray:
@@ -522,12 +549,15 @@ def sweep_from_config(cfg: dict[str, Any], fidelity: str | None = None) -> Sweep
     chunk = table.get("chunk_size", 50)
     if chunk < 1:
         raise ValueError(f"sweep.chunk_size = {chunk} is out of range; valid range: integer >= 1")
-    reference = table.get("quasi_static_reference", fid.dynamics == "tribo_dynamic")
-    if reference and fid.dynamics == "quasi_static":
-        reference = False  # the sweep is the quasi-static model already
     op = OperatingPoint(
         torque=torque, speed_rpm=float(speeds[0]), inlet_temperature=inlet_c + 273.15
     )
+    reasons = None
+    if fid_echo["preset"] == "auto":
+        fid, reasons = _auto_fidelity(pair, lub, surf, op, speeds, vary, fid, fid_echo["tolerance"])
+    reference = table.get("quasi_static_reference", fid.dynamics == "tribo_dynamic")
+    if reference and fid.dynamics == "quasi_static":
+        reference = False  # the sweep is the quasi-static model already
     echo = {
         "gear": dict(cfg.get("gear", {})) or {"preset": "li2015_calibrated"},
         "lubricant": lub_echo,
@@ -556,4 +586,22 @@ def sweep_from_config(cfg: dict[str, Any], fidelity: str | None = None) -> Sweep
         quasi_static_reference=bool(reference),
         progress=table.get("progress", True),
         echo=echo,
+        fidelity_reasons=reasons,
     )
+
+
+def _auto_fidelity(pair, lub, surf, op, speeds, vary, base, tolerance):
+    """``[fidelity] preset = "auto"``: ``jg.choose_fidelity`` over the sweep's speeds, keeping the
+    base's other fields. The indicators are those of ``[operating]``, so inputs that move them may
+    not vary per speed."""
+    from .fidelity_auto import choose_fidelity
+
+    moving = sorted(k for k in vary if k != "tip_relief_amount")
+    if moving:
+        key = {v[0]: k for k, v in _VARY_KEYS.items()}[moving[0]]
+        raise ValueError(
+            f"sweep.vary.{key} cannot be used with fidelity preset = 'auto' (the choice is made "
+            "from [operating] and [surfaces]); set the value there, or give a fixed preset"
+        )
+    choice = choose_fidelity(pair, lub, surf, op, tolerance, speeds_rpm=speeds, base=base)
+    return choice.fidelity, choice.reasons

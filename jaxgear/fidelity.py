@@ -164,7 +164,8 @@ class Fidelity(eqx.Module):
 
         Logic, options and the measured table: ``jaxgear.fidelity_auto``. A Fidelity is static, so
         the reasons travel separately: ``jg.choose_fidelity`` (same arguments) returns them.
-        """
+        ``base=Fidelity(...)`` keeps that Fidelity's fields other than the ladder's (μb, shear law,
+        asperity constants, fixed-point settings); by default they are ``Fidelity()``'s."""
         from .fidelity_auto import auto_fidelity
 
         return auto_fidelity(pair, lubricant, surfaces, op, tolerance, **options)

@@ -486,10 +486,45 @@ def _predict(tab: _Table, physics, level, query: Mapping):
     return total, terms
 
 
-def _fidelity_of(tab: _Table, physics, level) -> Fidelity:
+def _fidelity_of(tab: _Table, physics, level, base: Fidelity | None = None) -> Fidelity:
+    """The Fidelity of (physics, level): the ladder's fields from the table, every other field
+    (μb, shear law, asperity constants, fixed-point settings...) from ``base``."""
+    base = Fidelity() if base is None else base
     if physics == tab.ref_physics and level == tab.reference.get("level"):
-        return Fidelity(**tab.reference["fidelity"])
-    return Fidelity(**dict(zip(AXIS_ORDER, physics)), **tab.levels[level])
+        return base.replace(**tab.reference["fidelity"])
+    return base.replace(**dict(zip(AXIS_ORDER, physics)), **tab.levels[level])
+
+
+#: Fields of a Fidelity the choice sets: the physics axes and the resolution.
+LADDER_FIELDS = (*AXIS_ORDER, *RESOLUTION_FIELDS)
+
+
+def _check_base(base) -> Fidelity | None:
+    if base is not None and not isinstance(base, Fidelity):
+        raise ValueError(f"base = {base!r} is not valid; valid: a jaxgear.Fidelity or None")
+    return base
+
+
+def _settings_note(base: Fidelity | None) -> str | None:
+    """Words on the settings kept from ``base`` that differ from the defaults the table was measured
+    at (benchmarks/fidelity_trade.py runs every rung with Fidelity()'s other fields)."""
+    if base is None:
+        return None
+    default = Fidelity()
+    changed = [
+        f"{f.name} = {getattr(base, f.name)!r} (table: {getattr(default, f.name)!r})"
+        for f in dataclasses.fields(Fidelity)
+        if f.name not in LADDER_FIELDS and getattr(base, f.name) != getattr(default, f.name)
+    ]
+    if not changed:
+        return None
+    return (
+        "Kept from base: "
+        + "; ".join(changed)
+        + ". The table measured every rung at the defaults in brackets, so its errors are carried "
+        "over to these settings unmeasured (they move the friction level of every EHL rung alike, "
+        "not the ladder's order)."
+    )
 
 
 def _query(indicators: ScenarioIndicators | Mapping) -> dict:
@@ -518,10 +553,12 @@ def choose_from_indicators(
     *,
     quantities: Sequence[str] = ("power_loss", "efficiency"),
     table: Mapping | str | Path | None = None,
+    base: Fidelity | None = None,
 ) -> FidelityChoice:
     """:func:`choose_fidelity` for given indicators (a ``ScenarioIndicators`` or a dict with at least
     the axis indicators of ``AXIS_INDICATOR``); the pure part of the choice, for tests and sweeps."""
     quantities = _check_request(tolerance, quantities)
+    base = _check_base(base)
     raw = _shipped_table() if table is None else table
     raw = load_error_table(raw) if isinstance(raw, str | Path) else raw
     tab = _Table(raw)
@@ -535,10 +572,13 @@ def choose_from_indicators(
             if best is None or key < best[0]:
                 best = (key, physics, level, tab.run_seconds(physics, level), total, terms)
     _, physics, level, seconds, total, terms = best  # the reference itself always qualifies
-    fid = _fidelity_of(tab, physics, level)
+    fid = _fidelity_of(tab, physics, level, base)
     reasons = _reasons(
         tab, fid, physics, level, seconds, total, terms, query, tolerance, quantities
     )
+    note = _settings_note(base)
+    if note:
+        reasons += "\n" + note
     ind = (indicators,) if isinstance(indicators, ScenarioIndicators) else ()
     return FidelityChoice(
         fidelity=fid,
@@ -685,6 +725,7 @@ def choose_fidelity(
     quantities: Sequence[str] = ("power_loss", "efficiency"),
     table: Mapping | str | Path | None = None,
     speeds_rpm: Sequence[float] | None = None,
+    base: Fidelity | None = None,
 ) -> FidelityChoice:
     """The cheapest fidelity whose measured error stays under ``tolerance``, and why.
 
@@ -699,22 +740,30 @@ def choose_fidelity(
         speeds_rpm: for a sweep, the speeds (rpm) that ``op``'s speed stands in for: the choice is
             made at each speed and the most demanding rung of each axis is kept, so one Fidelity
             (one compiled program) serves the whole sweep.
+        base: a Fidelity whose fields other than the ladder's (``LADDER_FIELDS``: the four physics
+            axes and the resolution) the choice keeps, e.g. ``Fidelity(boundary_friction=0.08,
+            shear="eyring_exact")``; default ``Fidelity()``'s. The reasons name the kept settings
+            that differ from the defaults the table was measured at.
 
     Returns:
         FidelityChoice (``.fidelity``, ``.reasons``, ``.predicted_error``, ``.time_per_point``, ...).
     """
     quantities = _check_request(tolerance, quantities)
+    base = _check_base(base)
     raw = _shipped_table() if table is None else table
     raw = load_error_table(raw) if isinstance(raw, str | Path) else raw
-    base = _speed_free_part(pair, lubricant, surfaces, op.torque, op.inlet_temperature)
+    part = _speed_free_part(pair, lubricant, surfaces, op.torque, op.inlet_temperature)
     if speeds_rpm is None:
-        ind = _at_speed(base, _f(op.speed_rpm))
-        return choose_from_indicators(ind, tolerance, quantities=quantities, table=raw)
+        ind = _at_speed(part, _f(op.speed_rpm))
+        return choose_from_indicators(ind, tolerance, quantities=quantities, table=raw, base=base)
     speeds = [float(v) for v in np.atleast_1d(np.asarray(speeds_rpm, dtype=float))]
     if not speeds or not all(math.isfinite(v) and v > 0 for v in speeds):
         raise ValueError(f"speeds_rpm = {speeds_rpm!r} is not valid; valid: positive rpm values")
-    inds = [_at_speed(base, v) for v in speeds]
-    choices = [choose_from_indicators(i, tolerance, quantities=quantities, table=raw) for i in inds]
+    inds = [_at_speed(part, v) for v in speeds]
+    choices = [
+        choose_from_indicators(i, tolerance, quantities=quantities, table=raw, base=base)
+        for i in inds
+    ]
     tab = _Table(raw)
     # The most demanding rung of each axis over the speeds, and the finest resolution.
     physics = tuple(
@@ -723,7 +772,7 @@ def choose_fidelity(
     )
     levels = [_level_of(tab, c.fidelity) for c in choices]
     level = max(levels, key=lambda lv: _level_rank(tab, lv))
-    fid = _fidelity_of(tab, physics, level)
+    fid = _fidelity_of(tab, physics, level, base)
     totals = [_predict(tab, physics, level, _query(i))[0] for i in inds]
     worst = {q: max(t[q] for t in totals) for q in QUANTITIES}
     seconds = tab.run_seconds(physics, level)

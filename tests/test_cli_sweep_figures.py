@@ -9,6 +9,7 @@ import dataclasses
 import json
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -73,13 +74,36 @@ def test_example_config_resolves():
     cfg = sweep_from_config(load_toml(ROOT / "examples" / "sweep.toml"))
     assert cfg.mode == "continuation" and cfg.quasi_static_reference
     np.testing.assert_array_equal(cfg.speeds, np.arange(1000.0, 4001.0, 250.0))
-    assert cfg.fidelity == Fidelity.fast(n_positions=32)
+    assert cfg.fidelity == Fidelity.fast() and cfg.fidelity_reasons is None
     # The example's pair is the calibrated preset of `jaxgear run`.
     calibrated = jg.presets.li2015_pair_calibrated()
     np.testing.assert_allclose(cfg.pair.blank_mass, calibrated.blank_mass)
     np.testing.assert_allclose(cfg.pair.tip_relief.amount, calibrated.tip_relief.amount)
     paper = sweep_from_config(load_toml(ROOT / "examples" / "sweep.toml"), fidelity="paper")
-    assert paper.fidelity == Fidelity.paper(n_positions=32)
+    assert paper.fidelity == Fidelity.paper()
+
+
+def test_auto_config_chooses_and_keeps_the_other_fields():
+    """``preset = "auto"``: the ladder's fields are chosen over the sweep's speeds as
+    jg.choose_fidelity chooses them; every other [fidelity] key is kept, and the reasons say so."""
+    text = (
+        "[fidelity]\npreset = 'auto'\ntolerance = 0.05\nboundary_friction = 0.07\n"
+        "shear = 'eyring_exact'\n[sweep]\nspeeds_rpm = [1000.0, 2500.0]\n"
+    )
+    cfg = sweep_from_config(tomllib.loads(text))
+    base = Fidelity(boundary_friction=0.07, shear="eyring_exact")
+    expected = jg.choose_fidelity(
+        cfg.pair, cfg.lubricant, cfg.surfaces, cfg.op, 0.05, speeds_rpm=[1000.0, 2500.0], base=base
+    )
+    assert cfg.fidelity == expected.fidelity
+    assert cfg.fidelity.boundary_friction == 0.07 and cfg.fidelity.shear == "eyring_exact"
+    assert "boundary_friction = 0.07 (table: 0.1)" in cfg.fidelity_reasons
+    assert cfg.echo["fidelity"] == {
+        "preset": "auto",
+        "tolerance": 0.05,
+        "boundary_friction": 0.07,
+        "shear": "eyring_exact",
+    }
 
 
 SPEEDS = "[sweep]\nspeeds_rpm = [1000.0]\n"
@@ -98,6 +122,19 @@ BAD = [
     ("[fidelity]\nn_positions = 10\n" + SPEEDS, "fidelity.n_positions = 10 is out of range"),
     ("[fidelity]\nthermal = 'yes'\n" + SPEEDS, "fidelity.thermal = 'yes' has the wrong type"),
     ("[fidelity]\npreset = 'exact'\n" + SPEEDS, "fidelity preset = 'exact' is not valid"),
+    (
+        "[fidelity]\npreset = 'auto'\nn_nodes = 257\n" + SPEEDS,
+        "fidelity.n_nodes is chosen by preset = 'auto'",
+    ),
+    ("[fidelity]\ntolerance = 0.05\n" + SPEEDS, "fidelity.tolerance has no meaning with preset"),
+    (
+        "[fidelity]\npreset = 'auto'\ntolerance = 5.0\n" + SPEEDS,
+        "fidelity.tolerance = 5.0 is out of range; valid range: (0, 1)",
+    ),
+    (
+        "[fidelity]\npreset = 'auto'\n" + SPEEDS + "[sweep.vary]\ntorque_Nm = 1500.0\n",
+        "sweep.vary.torque_Nm cannot be used with fidelity preset = 'auto'",
+    ),
     ("[lubricant]\npreset = 'castor'\n" + SPEEDS, "lubricant.preset = 'castor' is not valid"),
     ("[lubricant]\neyring_stress = -1.0\n" + SPEEDS, "lubricant.eyring_stress = -1 Pa is out"),
     ("[surfaces]\npreset = 'sandblasted'\n" + SPEEDS, "surfaces.preset = 'sandblasted'"),

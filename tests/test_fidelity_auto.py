@@ -408,6 +408,46 @@ def test_fidelity_auto_returns_a_static_fidelity_and_reasons(rpm):
     assert choice.time_per_point is not None and choice.time_per_point > 0
 
 
+def test_auto_keeps_the_base_fidelitys_other_fields():
+    """The choice sets only the ladder's fields (physics axes, resolution): μb, the shear law, the
+    asperity constants and the fixed-point settings of ``base`` survive, and the reasons name the
+    ones that differ from the defaults the table was measured at."""
+    op = _op(2500.0)
+    plain = jg.choose_fidelity(CALIBRATED, LUB, jg.presets.ground(), op)
+    base = jg.Fidelity(
+        boundary_friction=0.08,
+        shear="newtonian",
+        asperity_density_product=0.08,
+        max_fixed_point_iterations=60,
+        # ladder fields of the base are replaced by the choice
+        friction="constant",
+        n_nodes=513,
+    )
+    kept = jg.choose_fidelity(CALIBRATED, LUB, jg.presets.ground(), op, base=base)
+    ladder = ("dynamics", "friction", "thermal", "transient", "n_positions", "n_nodes")
+    ladder += ("steps_per_period",)
+    assert {f: getattr(kept.fidelity, f) for f in ladder} == {
+        f: getattr(plain.fidelity, f) for f in ladder
+    }
+    assert kept.fidelity.boundary_friction == 0.08 and kept.fidelity.shear == "newtonian"
+    assert kept.fidelity.asperity_density_product == 0.08
+    assert kept.fidelity.max_fixed_point_iterations == 60
+    assert kept.predicted_error == plain.predicted_error
+    for words in ("boundary_friction = 0.08 (table: 0.1)", "shear = 'newtonian'"):
+        assert words in kept.reasons
+    assert "Kept from base" not in plain.reasons
+    # A base at the defaults changes nothing, and a sweep keeps the base too.
+    assert jg.Fidelity.auto(CALIBRATED, LUB, jg.presets.ground(), op, base=jg.Fidelity()) == (
+        plain.fidelity
+    )
+    sweep = jg.choose_fidelity(
+        CALIBRATED, LUB, jg.presets.ground(), op, speeds_rpm=[1000.0, 2500.0], base=base
+    )
+    assert sweep.fidelity.boundary_friction == 0.08 and "Kept from base" in sweep.reasons
+    with pytest.raises(ValueError, match="base = 'fast' is not valid"):
+        jg.choose_fidelity(CALIBRATED, LUB, jg.presets.ground(), op, base="fast")
+
+
 # -------------------------------------------------------------------------------------------------
 # Held-out scenarios: the choice against the table's reference, simulated
 # -------------------------------------------------------------------------------------------------

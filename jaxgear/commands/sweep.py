@@ -29,8 +29,10 @@ def register(sub) -> None:
     p.add_argument("--out", type=Path, default=Path("results"), help="output directory")
     p.add_argument(
         "--fidelity",
-        choices=("fast", "paper"),
-        help="fidelity preset; overrides [fidelity] preset (its other keys still apply)",
+        choices=("fast", "paper", "auto"),
+        help="fidelity preset; overrides [fidelity] preset (its other keys still apply); auto: "
+        "the cheapest rungs whose measured error stays under [fidelity] tolerance (default 0.05) "
+        "over the sweep's speeds (jg.choose_fidelity), with its reasons printed",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
@@ -41,6 +43,8 @@ def run(args: argparse.Namespace) -> int:
     from jaxgear.sweep import sweep
 
     cfg = sweep_from_config(load_toml(args.config), fidelity=args.fidelity)
+    if cfg.fidelity_reasons:
+        print(cfg.fidelity_reasons, flush=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     progress = cfg.progress and not args.no_progress
@@ -149,6 +153,8 @@ def _summary(cfg, main, reference, t_main, t_all):
         ],
         "messages": list(main.messages),
     }
+    if cfg.fidelity_reasons:
+        summary["fidelity_reasons"] = cfg.fidelity_reasons
     if reference is not None:
         summary["headline"]["quasi_static_mean_efficiency_percent"] = _nan_stat(
             np.nanmean, 100 * np.asarray(reference.efficiency)
