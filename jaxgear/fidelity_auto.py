@@ -801,7 +801,7 @@ def choose_fidelity(
 
 
 def _fields(fid: Fidelity) -> dict:
-    return {a: getattr(fid, a) for a in (*AXIS_ORDER, *RESOLUTION_FIELDS)}
+    return {a: getattr(fid, a) for a in LADDER_FIELDS}
 
 
 def _level_of(tab: _Table, fid: Fidelity):
