@@ -342,9 +342,13 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             u[..., 0],
             u[..., 1],
             op.inlet_temperature,
-            state["contacts"],
+            jax.lax.stop_gradient(state["contacts"]),
             period=period,
         )
+        # The EHL solutions ride along only as the next iteration's warm start: a converged solve
+        # does not depend on where it started, so they carry no derivative (and the implicit
+        # fixed-point system is not asked to solve for thousands of film nodes).
+        contacts = jax.lax.stop_gradient(contacts)
         new = interface_from_forces(forces)
         relaxed = jax.tree_util.tree_map(lambda a, b: (1.0 - beta) * a + beta * b, interface, new)
         return {
@@ -388,7 +392,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         "velocity": velocity0,
         "dte": mesh.static_te,
         "forces": forces0,
-        "contacts": contacts0,
+        "contacts": jax.lax.stop_gradient(contacts0),
         "dynamics_ok": jnp.asarray(1.0, dtype=zeros.dtype),
         "started": jnp.asarray(started0, dtype=zeros.dtype),
         "previous": zeros,

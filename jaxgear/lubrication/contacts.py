@@ -146,11 +146,20 @@ def ehl_contact_forces(
         power_sliding=take(ps),
         # (the sliding loss includes the asperity (boundary) friction of mixed lubrication)
         power_rolling=take(pr),
-        friction_coefficient=jnp.sqrt(fs**2 + fr**2) / jnp.where(loaded, load, 1.0) * mask,
+        friction_coefficient=_safe_norm(fs, fr) / jnp.where(loaded, load, 1.0) * mask,
         converged=~jnp.any(failed),
         failed=jnp.sum(failed.astype(jnp.int32)),
     )
     return forces, sols
+
+
+def _safe_norm(a, b):
+    """sqrt(a² + b²) with a finite derivative where both are zero (the masked slots): a plain sqrt
+    gives a NaN tangent there, which poisons the implicit fixed-point solve of the tribo-dynamic
+    rung (its linear system takes every leaf of the state, this one included)."""
+    sq = a**2 + b**2
+    positive = sq > 0
+    return jnp.where(positive, jnp.sqrt(jnp.where(positive, sq, 1.0)), 0.0)
 
 
 def _patch_failed(outputs, good, failed, w, u1, u2):
