@@ -107,6 +107,14 @@ def test_statistical_ground_vs_polished_regimes():
     # boundary friction adds to the fluid's: the ground contact has the larger friction coefficient
     w = float(gear_contact().load_per_width)
     assert abs(float(slow.friction_sliding)) / w > abs(float(fast.friction_sliding)) / w
+    # the derived fields of a batch of solutions (a passage's steps, a vmapped solve) are those of
+    # each member: the node axis is the last (they once summed over the batch axis as well)
+    both = jax.tree_util.tree_map(lambda a, b: jnp.stack([a, b]), slow, fast)
+    for one, k in ((slow, 0), (fast, 1)):
+        assert float(both.contact_load_share[k]) == pytest.approx(
+            float(one.contact_load_share), rel=1e-12
+        )
+        np.testing.assert_array_equal(np.asarray(both.temperatures[k]), one.temperatures)
 
 
 # --------------------------------------------------------------------------------------------------

@@ -335,8 +335,10 @@ class EHLSolution(eqx.Module):
 
     @property
     def temperatures(self):
-        """(film mean, surface 1, surface 2) temperatures at the nodes, K, shape (3, N)."""
-        return jnp.stack([self.temperature, self.surface_temperature1, self.surface_temperature2])
+        """(film mean, surface 1, surface 2) temperatures at the nodes, K, shape (3, N); (K, 3, N)
+        for a batch of K solutions."""
+        temps = [self.temperature, self.surface_temperature1, self.surface_temperature2]
+        return jnp.stack(temps, axis=-2)
 
     @property
     def fluid_pressure(self):
@@ -345,8 +347,10 @@ class EHLSolution(eqx.Module):
 
     @property
     def contact_load_share(self):
-        """Share of the load carried by asperity contact."""
-        return self.contact_load / jnp.maximum(jnp.sum(self.p) * (self.x[1] - self.x[0]), 1e-300)
+        """Share of the load carried by asperity contact (per solution of a batch, e.g. the steps
+        of a passage: the node axis is the last)."""
+        load = jnp.sum(self.p, axis=-1) * (self.x[..., 1] - self.x[..., 0])
+        return self.contact_load / jnp.maximum(load, 1e-300)
 
     @property
     def rho_h(self):
