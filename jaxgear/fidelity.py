@@ -9,6 +9,7 @@ traces the dynamics, an iso-thermal run never traces the thermal solver, and so 
 | friction | "constant" μ → "regression" (Xu et al. 2007) → "ehl_smooth" → "ehl_mixed" |
 | thermal | False (iso-thermal) → True |
 | transient | False (quasi-steady per position) → True |
+| coupling | "frozen" (contacts solved once, at the quasi-static state) → "fixed_point" |
 | resolution | n_positions per mesh cycle, n_nodes per contact, steps_per_period of the dynamics |
 """
 
@@ -20,6 +21,7 @@ import equinox as eqx
 
 DYNAMICS_RUNGS = ("quasi_static", "tribo_dynamic")
 FRICTION_RUNGS = ("constant", "regression", "ehl_smooth", "ehl_mixed")
+COUPLING_RUNGS = ("frozen", "fixed_point")
 STIFFNESS_METHODS = ("potential_energy", "iso")
 
 
@@ -35,6 +37,18 @@ class Fidelity(eqx.Module):
         friction: "constant", "regression", "ehl_smooth" or "ehl_mixed".
         thermal: thermal EHL (film and surface temperatures) instead of iso-thermal.
         transient: transient EHL marching through the engagement instead of quasi-steady contacts.
+        coupling: how the tribo-dynamic rung couples the contacts to the dynamics. "fixed_point"
+            (the paper's): every fixed-point iteration solves every contact again at the dynamic
+            loads and velocities. "frozen": the contacts are solved once, at the quasi-static state
+            (static load sharing, kinematic velocities), together with their derivative along the
+            load (forward mode through the converged solves); their outputs become coefficients
+            (Fs/(W s), Fr/W, cm, Φs/(W us s), Φr/(W um), s the smoothed sign of the sliding
+            velocity us), each a power law in the load with the local exponent, that the fixed point
+            scales to the dynamic loads and velocities, so each iteration costs one dynamics solve.
+            What it leaves out: the coefficients' dependence on the sliding speed, the transient
+            (squeeze) response to the dynamic load and its temperatures, and any non-power-law
+            load dependence (error and cost measured in benchmarks/RESULTS.md, coupling_trade).
+            No effect on the quasi-static rung.
         n_positions: positions per mesh cycle.
         n_nodes: EHL grid nodes per contact.
         steps_per_period: fixed Runge-Kutta steps per mesh period in the dynamics.
@@ -82,6 +96,7 @@ class Fidelity(eqx.Module):
     friction: str = _static("regression")
     thermal: bool = _static(False)
     transient: bool = _static(False)
+    coupling: str = _static("fixed_point")
     n_positions: int = _static(32)
     n_nodes: int = _static(129)
     steps_per_period: int = _static(64)
@@ -101,6 +116,7 @@ class Fidelity(eqx.Module):
     def __check_init__(self):
         _choice("Fidelity.dynamics", self.dynamics, DYNAMICS_RUNGS)
         _choice("Fidelity.friction", self.friction, FRICTION_RUNGS)
+        _choice("Fidelity.coupling", self.coupling, COUPLING_RUNGS)
         _choice("Fidelity.stiffness", self.stiffness, STIFFNESS_METHODS)
         _choice("Fidelity.backlash", self.backlash, ("exact", "smooth"))
         _choice("Fidelity.mixed_model", self.mixed_model, ("statistical", "deterministic"))
@@ -192,7 +208,8 @@ class Fidelity(eqx.Module):
         if self.fixed_point_tolerance is not None:
             return self.fixed_point_tolerance
         picard = self.uses_ehl and (self.thermal or self.friction == "ehl_mixed")
-        return 3e-3 if picard else 1e-4
+        # frozen coupling: the contacts are solved once, outside the iteration (no Picard noise)
+        return 3e-3 if picard and self.coupling == "fixed_point" else 1e-4
 
     @property
     def uses_ehl(self) -> bool:

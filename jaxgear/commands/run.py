@@ -224,6 +224,7 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
                     "friction",
                     "thermal",
                     "transient",
+                    "coupling",
                     "n_positions",
                     "n_nodes",
                     "steps_per_period",

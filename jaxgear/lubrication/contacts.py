@@ -19,6 +19,11 @@ from .ehl import EHLModel, LineContact, solve_ehl
 # touch at the edge of relief, where EHL has no meaning and contributes nothing measurable).
 LOADED_SHARE = 1e-4
 
+# Largest load exponent of a frozen coefficient (``frozen_contact_forces``). The EHL damping of
+# Eq. 13 peaks near the pitch point, where it grows like W^4-4.6 (measured: mixed EHL, 2500 rpm,
+# 24 × 65); friction and loss coefficients have exponents within ±0.5.
+_MAX_EXPONENT = 5.0
+
 
 def _sequential(fn):
     """Like ``jax.vmap(fn)`` over the leading axis, but one element after the other."""
@@ -153,6 +158,71 @@ def ehl_contact_forces(
     return forces, sols
 
 
+def frozen_contact_forces(
+    reference, reference_load, reference_velocity, load, velocity, total_load, load_tangent=None
+):
+    """``Fidelity.coupling = "frozen"``: the contact forces at the dynamic ``load`` [M, 2] and
+    ``velocity`` [M, 2, 2] from the ``reference`` ContactForces solved once at ``reference_load``
+    and ``reference_velocity`` (the quasi-static state), through ``contact_coefficients``.
+
+    ``load_tangent``: the derivative of the reference outputs along a uniform scaling of the loads,
+    W ∂F/∂W (a ContactForces of tangents, from ``jax.jvp``). With it each coefficient follows a power
+    law in the load, c (W/W0)^b with b = ∂ln c/∂ln W at the reference (clipped to [−5, 5]), which
+    carries the fall of the friction coefficient with load that a constant coefficient misses; without
+    it the coefficients are constant.
+
+    Slots unloaded in the reference (before or after the static contact, or unloaded by tip relief)
+    take the coefficients of the nearest loaded one along the engagement, so a contact that the
+    vibration loads where the static mesh does not still carries friction; slots unloaded now carry
+    none. ``converged`` and ``failed`` are the reference's.
+    """
+    from ..tribodynamics import ContactForces
+
+    def in_use(w, u):
+        return (w > LOADED_SHARE * total_load) & (u[..., 0] + u[..., 1] > 0)
+
+    def outputs(forces):
+        return (
+            forces.friction_sliding,
+            forces.friction_rolling,
+            forces.damping,
+            forces.power_sliding,
+            forces.power_rolling,
+        )
+
+    u1r, u2r = reference_velocity[..., 0], reference_velocity[..., 1]
+    good = in_use(reference_load, reference_velocity)
+    coefficients = contact_coefficients(outputs(reference), good, reference_load, u1r, u2r)
+    mask = in_use(load, velocity).astype(load.dtype)
+    safe_load = jnp.where(mask > 0, load, 1.0)
+    if load_tangent is not None:
+        tangents = contact_coefficients(outputs(load_tangent), good, reference_load, u1r, u2r)
+        w0 = fill_engagement(reference_load, good)
+        ratio = safe_load / jnp.where(w0 > 0, w0, 1.0)
+        # scales ∝ W except the damping's (1): ∂ln c/∂ln W = (W ∂F/∂W)/(c · scale) − 1
+        own = (1.0, 1.0, 0.0, 1.0, 1.0)
+        powered = []
+        for c, t, k in zip(coefficients, tangents, own):
+            nonzero = jnp.abs(c) > 0
+            b = jnp.where(nonzero, t / jnp.where(nonzero, c, 1.0) - k, 0.0)
+            powered.append(c * ratio ** jnp.clip(b, -_MAX_EXPONENT, _MAX_EXPONENT))
+        coefficients = tuple(powered)
+    fs, fr, cm, ps, pr = (
+        a * mask
+        for a in scale_coefficients(coefficients, safe_load, velocity[..., 0], velocity[..., 1])
+    )
+    return ContactForces(
+        friction_sliding=fs,
+        friction_rolling=fr,
+        damping=cm,
+        power_sliding=ps,
+        power_rolling=pr,
+        friction_coefficient=_safe_norm(fs, fr) / safe_load * mask,
+        converged=reference.converged,
+        failed=reference.failed,
+    )
+
+
 def _safe_norm(a, b):
     """sqrt(a² + b²) with a finite derivative where both are zero (the masked slots): a plain sqrt
     gives a NaN tangent there, which poisons the implicit fixed-point solve of the tribo-dynamic
@@ -170,30 +240,59 @@ def _patch_failed(outputs, good, failed, w, u1, u2):
     A failed contact solve (not converged, or non-finite) can leave any value: seen, a coarse
     (65-node) transient march at 1500 N m whose one failed state near the pitch point gave a rolling
     loss of 3.6e19 W while its neighbours gave 30-40 W. Its own outputs are therefore never used. The
-    coefficients carried over are Fs/(W s), Fr/W, Φs/(W |us|), Φr/(W um) and cm itself, with s the
-    sign of u2 − u1 smoothed over 2 % slide-to-roll ratio, so the sliding friction changes sign with
-    the sliding velocity across the pitch point. The contact stays reported: ``converged`` is False
-    (status 3) and ``failed`` counts it. No good contact at all: zeros.
+    coefficients carried over are those of ``contact_coefficients`` (Fs/(W s), Fr/W, cm,
+    Φs/(W us s), Φr/(W um), with s the sign of us = u2 − u1 smoothed over 2 % slide-to-roll ratio,
+    so the sliding friction changes sign with the sliding velocity across the pitch point). The contact stays
+    reported: ``converged`` is False (status 3) and ``failed`` counts it. No good contact at all:
+    zeros.
     """
+    coefficients = contact_coefficients(outputs, good, w, u1, u2)
+    filled = scale_coefficients(coefficients, w, u1, u2)
+    return tuple(
+        jnp.where(failed, f, jnp.where(good, value, 0.0)) for f, value in zip(filled, outputs)
+    )
+
+
+def coefficient_scales(w, u1, u2):
+    """What each contact output (Fs, Fr, cm, Φs, Φr) is carried over in proportion to: W s, W, 1,
+    W us s, W um (``w`` a load, per width or not; s = us/(us² + (0.02 um)²)^½ the sign of
+    us = u2 − u1 smoothed over 2 % slide-to-roll ratio, as the formula rungs' friction). A constant
+    μ gives Fs = μ W s and Φs = Fs us = μ W us s: constant coefficients, whatever the velocities."""
     from ..tribodynamics import SIGN_SLIDE_TO_ROLL
 
-    fs, fr, cm, ps, pr = outputs
-    m = w.shape[0]
     us = u2 - u1
     um = 0.5 * (u1 + u2)
-    slip = jnp.sqrt(us**2 + (SIGN_SLIDE_TO_ROLL * um) ** 2)
-    scale = (w * us / slip, w, jnp.ones_like(w), w * slip, w * um)
+    sign = us / jnp.sqrt(us**2 + (SIGN_SLIDE_TO_ROLL * um) ** 2)
+    return (w * sign, w, jnp.ones_like(w), w * us * sign, w * um)
+
+
+def contact_coefficients(outputs, good, w, u1, u2):
+    """The outputs (Fs, Fr, cm, Φs, Φr) per [position, slot] divided by ``coefficient_scales``,
+    where ``good``; elsewhere the nearest good contact's along the engagement (zeros if none is).
+    An entry whose scale vanishes (the sliding ones at the pitch point) is not good for that
+    output: its coefficient comes from the nearest entry whose scale does not."""
+    out = []
+    for value, sc in zip(outputs, coefficient_scales(w, u1, u2)):
+        size = jnp.max(jnp.where(good, jnp.abs(sc), 0.0))
+        usable = good & (jnp.abs(sc) > 1e-9 * size)
+        sc_safe = jnp.where(usable, sc, 1.0)
+        out.append(fill_engagement(jnp.where(usable, value / sc_safe, 0.0), usable))
+    return tuple(out)
+
+
+def fill_engagement(values, good):
+    """``values`` [M, 2] with each entry not ``good`` replaced by the nearest good one along the
+    engagement (MeshCycle order: slot 0's positions, then slot 1's); zeros if none is good."""
+    m = values.shape[0]
     seq = lambda a: jnp.reshape(jnp.swapaxes(a, 0, 1), (-1,))
     unseq = lambda a: jnp.swapaxes(jnp.reshape(a, (2, m)), 0, 1)
-    ok = seq(good)
-    out = []
-    for value, sc in zip((fs, fr, cm, ps, pr), scale):
-        sc_safe = jnp.where(jnp.abs(sc) > 0, sc, 1.0)
-        coefficient = jnp.where(good, value / sc_safe, 0.0)
-        filled = unseq(_fill_nearest(seq(coefficient), ok)) * sc
-        filled = jnp.where(jnp.any(good), filled, 0.0)
-        out.append(jnp.where(failed, filled, jnp.where(good, value, 0.0)))
-    return tuple(out)
+    filled = unseq(_fill_nearest(seq(values), seq(good)))
+    return jnp.where(jnp.any(good), filled, 0.0)
+
+
+def scale_coefficients(coefficients, w, u1, u2):
+    """``contact_coefficients`` back to outputs at the load ``w`` and velocities u1, u2."""
+    return tuple(c * sc for c, sc in zip(coefficients, coefficient_scales(w, u1, u2)))
 
 
 def _fill_nearest(values, valid, causal=False):
