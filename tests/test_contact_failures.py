@@ -28,8 +28,8 @@ def _synthetic(m=5):
     us = jnp.linspace(-2.0, 2.0, 2 * m).reshape(2, m).T  # u2 − u1
     u1, u2 = um - 0.5 * us, um + 0.5 * us
     sign = us / jnp.sqrt(us**2 + (0.02 * um) ** 2)
-    slip = jnp.sqrt(us**2 + (0.02 * um) ** 2)
-    exact = (MU_S * w * sign, MU_R * w, jnp.full_like(w, CM), K_S * w * slip, K_R * w * um)
+    # the sliding loss of a sliding friction K_S w sign is that force times us
+    exact = (MU_S * w * sign, MU_R * w, jnp.full_like(w, CM), K_S * w * us * sign, K_R * w * um)
     return w, u1, u2, exact
 
 
