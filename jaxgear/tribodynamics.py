@@ -304,6 +304,22 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     m = mesh.n_positions
     period = mesh_period(pair, op.speed_rpm)
 
+    def contacts_at(load, velocity, initial=None):
+        """The contacts of the cycle at tooth forces ``load`` and surface velocities ``velocity``."""
+        return contact_forces(
+            pair,
+            lubricant,
+            surfaces,
+            mesh,
+            fidelity,
+            load,
+            velocity[..., 0],
+            velocity[..., 1],
+            op.inlet_temperature,
+            initial,
+            period=period,
+        )
+
     def respond(interface, guess):
         return dynamic_response(
             pair, op, mesh=mesh, interface=interface, options=options, initial_state=guess
@@ -341,19 +357,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             )
             contacts = state["contacts"]
         else:
-            forces, contacts = contact_forces(
-                pair,
-                lubricant,
-                surfaces,
-                mesh,
-                fidelity,
-                load,
-                u[..., 0],
-                u[..., 1],
-                op.inlet_temperature,
-                jax.lax.stop_gradient(state["contacts"]),
-                period=period,
-            )
+            forces, contacts = contacts_at(load, u, jax.lax.stop_gradient(state["contacts"]))
         # The EHL solutions ride along only as the next iteration's warm start: a converged solve
         # does not depend on where it started, so they carry no derivative (and the implicit
         # fixed-point system is not asked to solve for thousands of film nodes).
@@ -385,18 +389,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     # (one cold and one warm trace of the solver); formula rungs carry no contact state. Frozen
     # coupling: these are the only contact solves (``step`` scales them).
     def quasi_static_contacts(load_scale):
-        return contact_forces(
-            pair,
-            lubricant,
-            surfaces,
-            mesh,
-            fidelity,
-            mesh.normal_load * load_scale,
-            velocity0[..., 0],
-            velocity0[..., 1],
-            op.inlet_temperature,
-            period=period,
-        )
+        return contacts_at(mesh.normal_load * load_scale, velocity0)
 
     one = jnp.ones((), dtype=zeros.dtype)
     tangent0 = None
