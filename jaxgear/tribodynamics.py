@@ -141,6 +141,58 @@ def formula_contact_forces(
     )
 
 
+def formula_ehl_contact_forces(
+    pair: GearPair,
+    lubricant,
+    surfaces,
+    mesh: MeshCycle,
+    fidelity: Fidelity,
+    load,
+    u1,
+    u2,
+    inlet_temperature,
+) -> ContactForces:
+    """The "ehl_formula" rung: each loaded contact by the closed-form mixed EHL model of
+    ``lubrication/ehl_formula.py`` (sliding and rolling loss, damping cm), iso-thermal and
+    quasi-steady, with the EHL rungs' shear law, μb and Greenwood-Tripp constants."""
+    from .lubrication.ehl_formula import ehl_formula_contact
+
+    width = pair.face_width
+    loaded = load > 0
+    w = jnp.where(loaded, load, mesh.total_load) / width  # a finite stand-in where unloaded
+    ve = u1 + u2
+    ok_u = ve > 0
+    c = ehl_formula_contact(
+        mesh.reduced_radius,
+        w,
+        jnp.where(ok_u, u1, 1.0),
+        jnp.where(ok_u, u2, 1.0),
+        reduced_modulus(*pair.materials),
+        lubricant,
+        inlet_temperature,
+        surfaces.composite_rq,
+        boundary_friction=fidelity.boundary_friction,
+        shear=fidelity.shear,
+        density_product=fidelity.asperity_density_product,
+        slope_ratio=fidelity.asperity_slope_ratio,
+        sign_width=SIGN_SLIDE_TO_ROLL * 0.5 * jnp.abs(ve) + 1e-9,
+    )
+    on = loaded & ok_u
+    per_pair = lambda x: jnp.where(on, x * width, 0.0)
+    fs, fr = per_pair(c.friction_sliding), per_pair(c.friction_rolling)
+    safe_load = jnp.where(on, load, 1.0)
+    return ContactForces(
+        friction_sliding=fs,
+        friction_rolling=fr,
+        damping=per_pair(c.damping),
+        power_sliding=per_pair(c.power_sliding),
+        power_rolling=per_pair(c.power_rolling),
+        friction_coefficient=jnp.where(on, _safe_sqrt(fs * fs + fr * fr) / safe_load, 0.0),
+        converged=jnp.asarray(True),
+        failed=jnp.asarray(0, dtype=jnp.int32),
+    )
+
+
 def contact_forces(
     pair,
     lubricant,
@@ -159,6 +211,11 @@ def contact_forces(
     Returns (ContactForces, contact state): the contact state is the batch of EHL solutions on the EHL
     rungs (a warm start for the next evaluation, and the fields), None on the formula rungs.
     """
+    if fidelity.friction == "ehl_formula":
+        forces = formula_ehl_contact_forces(
+            pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature
+        )
+        return forces, None
     if fidelity.friction in ("constant", "regression"):
         forces = formula_contact_forces(
             pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature
