@@ -6,7 +6,7 @@ traces the dynamics, an iso-thermal run never traces the thermal solver, and so 
 | axis | rungs (cheap → expensive) |
 |---|---|
 | dynamics | "quasi_static" (W_T = W_sT, kinematic velocities) → "tribo_dynamic" |
-| friction | "constant" μ → "regression" (Xu et al. 2007) → "ehl_smooth" → "ehl_mixed" |
+| friction | "constant" μ → "regression" (Xu 2007) → "ehl_formula" → "ehl_smooth" → "ehl_mixed" |
 | thermal | False (iso-thermal) → True |
 | transient | False (quasi-steady per position) → True |
 | coupling | "frozen" (contacts solved once, at the quasi-static state) → "fixed_point" |
@@ -20,7 +20,7 @@ import dataclasses
 import equinox as eqx
 
 DYNAMICS_RUNGS = ("quasi_static", "tribo_dynamic")
-FRICTION_RUNGS = ("constant", "regression", "ehl_smooth", "ehl_mixed")
+FRICTION_RUNGS = ("constant", "regression", "ehl_formula", "ehl_smooth", "ehl_mixed")
 COUPLING_RUNGS = ("frozen", "fixed_point")
 STIFFNESS_METHODS = ("potential_energy", "iso")
 
@@ -34,7 +34,12 @@ class Fidelity(eqx.Module):
 
     Attributes:
         dynamics: "quasi_static" or "tribo_dynamic".
-        friction: "constant", "regression", "ehl_smooth" or "ehl_mixed".
+        friction: "constant", "regression", "ehl_formula", "ehl_smooth" or "ehl_mixed".
+            "ehl_formula" is the statistical mixed EHL contact in closed form (Pan-Hamrock film,
+            Greenwood-Tripp asperity load, Eyring fluid traction over the Hertz zone,
+            Goksem-Hargreaves rolling traction: ``lubrication/ehl_formula.py``); it uses
+            ``shear``, ``boundary_friction`` and the asperity constants like the EHL rungs, and is
+            iso-thermal and quasi-steady (``thermal`` and ``transient`` act on the EHL rungs only).
         thermal: thermal EHL (film and surface temperatures) instead of iso-thermal.
         transient: transient EHL marching through the engagement instead of quasi-steady contacts.
         coupling: how the tribo-dynamic rung couples the contacts to the dynamics. "fixed_point"
@@ -145,9 +150,12 @@ class Fidelity(eqx.Module):
 
     @classmethod
     def fast(cls, **changes) -> Fidelity:
-        """The CLI default: tribo-dynamic, regression-formula friction, 32 positions per cycle."""
+        """The CLI default: tribo-dynamic, closed-form mixed EHL friction ("ehl_formula": sliding
+        and rolling loss, EHL damping), 32 positions per cycle. Measured against ``paper()``
+        (benchmarks/RESULTS.md, fidelity_trade): within 8 % in Φ̄ on the six scenarios of the quick
+        set, at a few hundredths of a second per point."""
         _check_fields(changes)
-        return cls(**changes)
+        return cls(**{"friction": "ehl_formula", **changes})
 
     @classmethod
     def paper(cls, **changes) -> Fidelity:
@@ -213,7 +221,13 @@ class Fidelity(eqx.Module):
 
     @property
     def uses_ehl(self) -> bool:
+        """The contacts are solved by the EHL solver (pressure and film fields exist)."""
         return self.friction in ("ehl_smooth", "ehl_mixed")
+
+    @property
+    def models_rolling(self) -> bool:
+        """The friction rung gives a rolling (Poiseuille) loss and EHL damping."""
+        return self.friction in ("ehl_formula", "ehl_smooth", "ehl_mixed")
 
 
 def _check_fields(changes):

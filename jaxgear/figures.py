@@ -558,7 +558,7 @@ def _fig4(repro):
         a.plot(repro.speeds, _parts(qs)[key], ls, color="C1", label=f"{key}, quasi-static")
     _flag(a, repro.speeds, td.power_loss, td.converged)
     _mark_points(a, repro, td.power_loss)
-    if not repro.fidelity.uses_ehl:
+    if not repro.fidelity.models_rolling:
         a.text(
             0.02,
             0.97,
@@ -917,12 +917,12 @@ def paper_table(repro: PaperReproduction) -> list[dict]:
     rows.append(_variant_row(repro, "R8", "polished", "polished", "ground"))
 
     # R9
-    if not fid.uses_ehl:
+    if not fid.models_rolling:
         rows.append(
             _not_evaluated(
                 "R9",
                 f"the friction rung {fid.friction!r} models the sliding loss only (no rolling "
-                "loss); use an EHL rung",
+                "loss); use the ehl_formula or an EHL rung",
             )
         )
     else:

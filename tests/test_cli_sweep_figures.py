@@ -7,6 +7,7 @@ Cost: the default tests run the quasi-static rung (one cheap compile each); the 
 
 import dataclasses
 import json
+import re
 import subprocess
 import sys
 import tomllib
@@ -231,9 +232,18 @@ def test_figures_quick_cli(tmp_path, capsys, monkeypatch):
     assert "solves no EHL contact" in manifest["skipped"]["Fig. 7"]
     assert manifest["points_source"] == "nominal" and manifest["quick"]
     assert manifest["fidelity"]["n_positions"] == 24
-    # The fast rung's physics where it can judge: polished below ground, 1500 N m above 700 N m.
-    assert rows["R7"]["agrees"] is True and rows["R8"]["agrees"] is True
-    for rid in ("R5", "R9", "R10"):
+    # The fast rung's physics where it can judge: a colder oil and polished teeth lose less and
+    # 1500 N m loses over 1.5x more than 700 N m (the row's Psi half, 1500 N m slightly less
+    # efficient, is the open point it shares with the paper fidelity: README, issue 6).
+    assert rows["R6"]["agrees"] is True and rows["R8"]["agrees"] is True
+    ratio = float(re.search(r"700 N m ([0-9.]+)", rows["R7"]["jaxgear"]).group(1))
+    assert ratio > 1.5, rows["R7"]
+    # The closed-form mixed EHL rung models the rolling loss, so R9 is judged (not skipped) and
+    # sliding dominates at the lowest speed.
+    assert rows["R9"]["agrees"] is not None
+    share = [float(v) for v in re.findall(r"([0-9.]+) % at", rows["R9"]["jaxgear"])]
+    assert share[0] < 50.0 and share[-1] > share[0], rows["R9"]
+    for rid in ("R5", "R10"):
         assert rows[rid]["agrees"] is None
     assert "temperature part not evaluated" in rows["R11"]["note"]
 
