@@ -107,7 +107,9 @@ SCENARIOS = (
 #: Physics of the ladder, (dynamics, friction, thermal, transient); thermal and transient are options
 #: of the EHL rungs only (the formula rungs ignore them), so the formula rungs appear once.
 FORMULA_PHYSICS = [
-    (d, f, False, False) for d in AXIS_ORDER["dynamics"] for f in ("constant", "regression")
+    (d, f, False, False)
+    for d in AXIS_ORDER["dynamics"]
+    for f in ("constant", "regression", "ehl_formula")
 ]
 EHL_PHYSICS = [
     (d, f, th, tr)
@@ -152,6 +154,28 @@ class Runner:
         if cache_path is not None and cache_path.exists():
             self.cache.update(json.loads(cache_path.read_text()))
         self.compiled = {}
+
+    def seed(self, table: dict) -> None:
+        """Cache the points of an earlier table (``--seed-from-table``): every available rung's and
+        the reference's results per scenario, and their compile times."""
+        by_name = {s.name: s for s in SCENARIOS}
+        entries = [(r["fidelity"], r["results"], r.get("compile_s")) for r in table["rungs"]]
+        ref = table["reference"]
+        ref_results = {n: s["reference_result"] for n, s in table["scenarios"].items()}
+        entries.append((ref["fidelity"], ref_results, ref.get("compile_s")))
+        seeded = 0
+        for fields, results, compile_s in entries:
+            key = json.dumps(fields, sort_keys=True)
+            for name, res in results.items():
+                if name in by_name and res is not None:
+                    self.cache["points"].setdefault(key + "|" + by_name[name].key(), res)
+                    seeded += 1
+            if compile_s is not None:
+                self.cache["compile"].setdefault(key, compile_s)
+                self.cache.setdefault("available", {})[key] = True
+        self.seeded_from = table.get("generated")
+        print(f"seeded {seeded} points from the table of {self.seeded_from}", flush=True)
+        self._save()
 
     def _save(self):
         if self.cache_path is not None:
@@ -394,6 +418,7 @@ def pareto_plot(rungs, reference, path: Path):
     colours = {
         "constant": "tab:gray",
         "regression": "tab:blue",
+        "ehl_formula": "tab:purple",
         "ehl_smooth": "tab:green",
         "ehl_mixed": "tab:red",
     }
@@ -496,7 +521,14 @@ def write_report(table, studies, figure_path, wall, quick, write=True):
         "",
         f"Machine: {table['machine']}; load average at the end {table['load_average']} (the 2 cores "
         "were shared with other engineers' jobs: run times are upper bounds, compare them within this "
-        f"table). Mode: {'quick' if quick else 'full'}; wall time {wall / 60:.0f} min.",
+        f"table). Mode: {'quick' if quick else 'full'}; wall time {wall / 60:.0f} min."
+        + (
+            f" Seeded (`--seed-from-table`) with the points of the table of {table['seeded_from']}: "
+            "the rungs and reference that table had keep their results and run times from that run "
+            "(same machine type); the rungs it lacked and the convergence studies ran now."
+            if table.get("seeded_from")
+            else ""
+        ),
         "",
         f"**Reference: {ref['label']}.** {ref['note']}. Every error below is measured against it"
         + (
@@ -715,12 +747,22 @@ def main(argv=None):
         action="store_true",
         help="pipeline check: formula rungs only, quick scenarios; writes no RESULTS.md section",
     )
+    ap.add_argument(
+        "--seed-from-table",
+        type=Path,
+        default=None,
+        help="pre-fill the cache with the points of an earlier measured-error table (its rungs and "
+        "reference), so that only rungs it lacks and the convergence studies run; their run times "
+        "then come from that table's run (its machine and date are kept in the report)",
+    )
     args = ap.parse_args(argv)
     quick = args.quick or args.smoke
     physics_set = FORMULA_PHYSICS if args.smoke else FORMULA_PHYSICS + EHL_PHYSICS
     t_start = time.perf_counter()
     pair = jg.presets.li2015_pair_calibrated()
     runner = Runner(pair, args.cache)
+    if args.seed_from_table is not None:
+        runner.seed(json.loads(args.seed_from_table.read_text()))
     scenarios = [s for s in SCENARIOS if s.quick or not quick]
     scen = {s.name: s for s in SCENARIOS}
     ehl_levels = ("coarse", "default") if quick else ("coarse", "default", "fine")
@@ -737,7 +779,7 @@ def main(argv=None):
     rungs = []
     for physics in sorted(physics_set, key=_rank):
         d, f, th, tr = physics
-        levels = ehl_levels if f.startswith("ehl") else tuple(LEVELS)
+        levels = ehl_levels if jg.Fidelity(friction=f).uses_ehl else tuple(LEVELS)
         why = None
         for level in levels:
             fid = jg.Fidelity(dynamics=d, friction=f, thermal=th, transient=tr, **LEVELS[level])
@@ -759,7 +801,7 @@ def main(argv=None):
                 rung["unavailable_reason"] = why
             rungs.append(rung)
     # Cheapest first, so a long run has the informative cheap rungs early.
-    order = {"constant": 0, "regression": 1, "ehl_smooth": 2, "ehl_mixed": 3}
+    order = {f: i for i, f in enumerate(AXIS_ORDER["friction"])}
     todo = sorted(
         (r for r in rungs if r["available"]),
         key=lambda r: (
@@ -829,6 +871,7 @@ def main(argv=None):
         "scenarios": scen_table,
         "rungs": rungs,
         "convergence": studies,
+        "seeded_from": getattr(runner, "seeded_from", None),
     }
     table["defaults_justification"] = justify_defaults(studies, table)
     pareto_plot(rungs, reference, args.figure)

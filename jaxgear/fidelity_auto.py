@@ -64,7 +64,7 @@ QUANTITIES = ("power_loss", "efficiency", "dte_rms")
 #: Ladder order of each physics axis (cheap → expensive).
 AXIS_ORDER = {
     "dynamics": ("quasi_static", "tribo_dynamic"),
-    "friction": ("constant", "regression", "ehl_smooth", "ehl_mixed"),
+    "friction": ("constant", "regression", "ehl_formula", "ehl_smooth", "ehl_mixed"),
     "thermal": (False, True),
     "transient": (False, True),
 }
@@ -335,6 +335,20 @@ def _physics_of(entry: Mapping) -> tuple:
     return tuple(entry[a] for a in AXIS_ORDER)
 
 
+#: Friction rungs that solve no EHL film: thermal and transient do not act on them, so the table
+#: measures them once (thermal = transient = False) and they stand for every value of those axes.
+FORMULA_FRICTION = ("constant", "regression", "ehl_formula")
+
+
+def _departs(axis: str, physics, reference) -> bool:
+    """Whether ``physics`` departs from the reference on ``axis`` (thermal and transient are not
+    axes of a formula friction rung: its error is measured whole, on the friction axis)."""
+    i = tuple(AXIS_ORDER).index(axis)
+    if axis in ("thermal", "transient") and physics[1] in FORMULA_FRICTION:
+        return False
+    return physics[i] != reference[i]
+
+
 def _hardness(axis: str, indicators: Mapping) -> float:
     name, sign = AXIS_INDICATOR[axis]
     value = indicators[name]
@@ -373,6 +387,8 @@ class _Table:
             base = self.reference_results
         else:
             physics = tuple(value if a == axis else v for a, v in zip(AXIS_ORDER, self.ref_physics))
+            if axis == "friction" and value in FORMULA_FRICTION:
+                physics = (physics[0], value, False, False)  # measured once (FORMULA_FRICTION)
             test = self.results(physics, self.anchor)
             base = self.results(self.ref_physics, self.anchor)
         if test is None or base is None:
@@ -474,7 +490,7 @@ def _predict(tab: _Table, physics, level, query: Mapping):
     """Predicted error per quantity of (physics, level) at the query, and the per-axis terms."""
     total = {q: 0.0 for q in QUANTITIES}
     terms = {}
-    changes = [(a, v) for a, v, r in zip(AXIS_ORDER, physics, tab.ref_physics) if v != r]
+    changes = [(a, v) for a, v in zip(AXIS_ORDER, physics) if _departs(a, physics, tab.ref_physics)]
     if level != tab.reference.get("level"):
         changes.append(("resolution", level))
     for axis, value in changes:
