@@ -686,14 +686,16 @@ def auto_and_reach(table) -> list[str]:
             f"Mean speed-up of the auto choice over the reference: {statistics.mean(ratios):.2g}× "
             f"(Reach: ≥ 5× against the paper fidelity; measured here against {ref['label']}).",
         ]
-    fast = rungs.get(f"{physics_label(('tribo_dynamic', 'regression', False, False))}@default")
+    f = jg.Fidelity.fast()
+    fast = rungs.get(f"{physics_label((f.dynamics, f.friction, f.thermal, f.transient))}@default")
     base = [n for n in good if n.startswith("base_")]
     if fast is not None and base:
         worst = max(fast["errors"][n]["power_loss"] for n in base if n in fast["errors"])
         t_fast = statistics.median(fast["results"][n]["run_s"] for n in base)
         t_ref = statistics.median(table["scenarios"][n]["reference_result"]["run_s"] for n in base)
         lines.append(
-            f"`Fidelity.fast()` over the baseline scenarios ({', '.join(base)}): Φ̄ within "
+            f"`Fidelity.fast()` ({f.dynamics}, {f.friction}) over the baseline scenarios "
+            f"({', '.join(base)}): Φ̄ within "
             f"{pct(worst, 1)} % of the reference, {t_ref / t_fast:.3g}× cheaper per point (Reach: "
             "within 15 % of the paper fidelity, ≥ 50× cheaper)."
         )
