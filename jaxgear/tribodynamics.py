@@ -155,10 +155,13 @@ def formula_ehl_contact_forces(
     """The "ehl_formula" rung: each loaded contact by the closed-form mixed EHL model of
     ``lubrication/ehl_formula.py`` (sliding and rolling loss, damping cm), iso-thermal and
     quasi-steady, with the EHL rungs' shear law, μb and Greenwood-Tripp constants."""
+    from .lubrication.contacts import LOADED_SHARE
     from .lubrication.ehl_formula import ehl_formula_contact
 
     width = pair.face_width
-    loaded = load > 0
+    # Loaded as on the EHL rungs: a touch below 1e-4 of the total load (the edge of tip relief, down
+    # to 1e-289 N) carries nothing; the formulas would give an unbounded film there.
+    loaded = load > LOADED_SHARE * mesh.total_load
     w = jnp.where(loaded, load, mesh.total_load) / width  # a finite stand-in where unloaded
     ve = u1 + u2
     ok_u = ve > 0

@@ -5,7 +5,8 @@ silent NaN, never a crash.
 
 Default tests run the cheap rungs through ``jg.sweep``, which vmaps all points of one rung into one
 compiled program (one compile per rung): the quasi-static rungs on the full three-level factorial
-(243 points each), the tribo-dynamic regression rung on every axis's extremes, combined corners and
+(243 points each), the tribo-dynamic regression and closed-form EHL (the fast preset's) rungs on
+every axis's extremes, combined corners and
 light load near the resonances of the calibrated pair. The ``slow`` set adds the tribo-dynamic corners
 of the whole box, the constant-μ tribo-dynamic rung, the contact loss and back-side impacts seen in
 the tooth forces themselves, and the smooth-EHL rung at the extremes.
@@ -126,15 +127,25 @@ def quasi_static_factorial(friction):
     return inputs, run_sweep(inputs, jg.Fidelity(dynamics="quasi_static", friction=friction))
 
 
-@pytest.mark.parametrize("friction", ["constant", "regression"])
+@pytest.mark.parametrize("friction", ["constant", "regression", "ehl_formula"])
 def test_quasi_static_full_factorial(friction):
     inputs, res = quasi_static_factorial(friction)
     good = check_finite_or_flagged(inputs, res, all_finite=True)
     # No iteration on these rungs: nothing may fail to converge anywhere in the box.
     assert good.all(), describe(inputs, res, ~good)
+    rough = inputs["roughness_scale"]
+    if friction == "ehl_formula":
+        # The closed-form EHL rung has a rolling (Poiseuille) loss at every point of the box ...
+        assert np.all(np.asarray(res.power_loss_rolling) > 0.0)
+        # ... and Greenwood-Tripp asperity contact: no asperity friction on ideally smooth
+        # surfaces, so roughness scale 3 never loses less than scale 0 at the same other settings
+        # (equal where the film is thick enough that the asperities do not touch).
+        less = np.zeros(rough.size, dtype=bool)
+        less[rough == 3.0] = res.power_loss[rough == 3.0] < res.power_loss[rough == 0.0]
+        assert not less.any(), "rougher but lower loss:\n" + describe(inputs, res, less)
+        return
     # The formula rungs model sliding loss only.
     np.testing.assert_array_equal(res.power_loss_rolling, 0.0)
-    rough = inputs["roughness_scale"]
     if friction == "constant":
         # μ is constant: the roughness scale, from 0 to 3, changes nothing.
         np.testing.assert_allclose(res.power_loss[rough == 3.0], res.power_loss[rough == 0.0])
@@ -143,7 +154,7 @@ def test_quasi_static_full_factorial(friction):
         assert np.all(res.power_loss[rough == 3.0] > res.power_loss[rough == 0.0])
 
 
-# -- tribo-dynamic, regression rung: every axis's extremes, corners, light load at resonance --------
+# -- tribo-dynamic, formula rungs: every axis's extremes, corners, light load at resonance ---------
 
 #: (torque N m, speed rpm, inlet K, roughness scale, relief m, backlash m)
 TRIBO_POINTS = [
@@ -173,8 +184,9 @@ TRIBO_POINTS = [
 ]
 
 
-def test_tribo_dynamic_extremes_and_resonance():
-    fid = jg.Fidelity(friction="regression")
+@pytest.mark.parametrize("friction", ["regression", "ehl_formula"])
+def test_tribo_dynamic_extremes_and_resonance(friction):
+    fid = jg.Fidelity(friction=friction)
     inputs = points(*TRIBO_POINTS)
     # One point per chunk: still one compile, and a slow point (50 rpm needs many integration
     # steps per mesh period) does not hold up a whole vmapped batch.
@@ -187,7 +199,7 @@ def test_tribo_dynamic_extremes_and_resonance():
     # of the same rung (at 2000 rpm, away from the resonances, the dynamic tooth forces move it a
     # little). Not so at the extremes: at 10 N m, 20000 rpm and 50 µm of relief the flanks separate
     # over most of the cycle and carry the load near the pitch point, and the loss drops 20-fold.
-    qs_inputs, qs = quasi_static_factorial("regression")
+    qs_inputs, qs = quasi_static_factorial(friction)
     base = np.ones(qs.status.shape, dtype=bool)
     for axis in AXES:
         base &= np.isclose(qs_inputs[axis], inputs[axis][0])
