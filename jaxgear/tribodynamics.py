@@ -29,7 +29,7 @@ from .fidelity import Fidelity
 from .gear.geometry import gear_geometry, mesh_period
 from .gear.mesh import MeshCycle, mesh_cycle
 from .gear.pair import GearPair
-from .lubrication.friction_models import XuFriction
+from .lubrication.friction_models import XuFriction, smooth_sign
 from .lubrication.lubricant import Lubricant
 from .lubrication.roughness import Surfaces
 from .material import reduced_modulus
@@ -82,10 +82,6 @@ class ContactForces(eqx.Module):
     failed: Int[Array, ""]
 
 
-def _smooth_sign(x, width):
-    return x / jnp.sqrt(x * x + width * width)
-
-
 def _safe_sqrt(x):
     ok = x > 0
     return jnp.where(ok, jnp.sqrt(jnp.where(ok, x, 1.0)), 0.0)
@@ -127,7 +123,7 @@ def formula_contact_forces(
         )
         mu = jnp.where(loaded, mu, 0.0)
     force = mu * jnp.where(loaded, load, 0.0)
-    sign = _smooth_sign(u2 - u1, SIGN_SLIDE_TO_ROLL * 0.5 * jnp.abs(u1 + u2) + 1e-9)
+    sign = smooth_sign(u2 - u1, SIGN_SLIDE_TO_ROLL * 0.5 * jnp.abs(u1 + u2) + 1e-9)
     zeros = jnp.zeros_like(force)
     return ContactForces(
         friction_sliding=force * sign,
@@ -214,13 +210,13 @@ def contact_forces(
     Returns (ContactForces, contact state): the contact state is the batch of EHL solutions on the EHL
     rungs (a warm start for the next evaluation, and the fields), None on the formula rungs.
     """
-    if fidelity.friction == "ehl_formula":
-        forces = formula_ehl_contact_forces(
-            pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature
+    if fidelity.friction in ("constant", "regression", "ehl_formula"):
+        closed_form = (
+            formula_ehl_contact_forces
+            if fidelity.friction == "ehl_formula"
+            else formula_contact_forces
         )
-        return forces, None
-    if fidelity.friction in ("constant", "regression"):
-        forces = formula_contact_forces(
+        forces = closed_form(
             pair, lubricant, surfaces, mesh, fidelity, load, u1, u2, inlet_temperature
         )
         return forces, None

@@ -14,6 +14,7 @@ import jax.numpy as jnp
 
 from ..material import reduced_modulus
 from .ehl import EHLModel, LineContact, solve_ehl
+from .friction_models import smooth_sign
 
 # A slot counts as loaded above this share of the total load (below it the contact is a few-newton
 # touch at the edge of relief, where EHL has no meaning and contributes nothing measurable).
@@ -262,7 +263,7 @@ def coefficient_scales(w, u1, u2):
 
     us = u2 - u1
     um = 0.5 * (u1 + u2)
-    sign = us / jnp.sqrt(us**2 + (SIGN_SLIDE_TO_ROLL * um) ** 2)
+    sign = smooth_sign(us, SIGN_SLIDE_TO_ROLL * um)
     return (w * sign, w, jnp.ones_like(w), w * us * sign, w * um)
 
 

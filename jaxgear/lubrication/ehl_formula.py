@@ -33,6 +33,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .asperity import asperity_pressure
+from .friction_models import smooth_sign
 
 # Gauss-Legendre nodes on [-1, 1]: the Hertz zone (fluid traction, asperity load on the flat film) and
 # the opening gap outside it (asperity load).
@@ -171,7 +172,7 @@ def ehl_formula_contact(
     damping = shear_integral / h_c
     fluid = damping * (u2 - u1)
     width = 0.01 * (u1 + u2) if sign_width is None else sign_width
-    sign = (u2 - u1) / jnp.sqrt((u2 - u1) ** 2 + width**2)
+    sign = smooth_sign(u2 - u1, width)
     asperity = boundary_friction * w_a * sign
     c_r, a_gu, a_rw = ROLLING_TRACTION
     rolling = c_r * (big_g * big_u) ** a_gu * big_w**a_rw * r / alpha

@@ -22,6 +22,13 @@ from jaxtyping import Array, Float
 
 from .._validation import check_finite, check_non_negative, check_positive
 
+
+def smooth_sign(x, width):
+    """sgn(x) smoothed over ``width`` (same units as x): x/(x² + width²)^½, odd and C∞; the sign
+    of the sliding speed in every friction rung (a real traction turns over a small slip, too)."""
+    return x / jnp.sqrt(x * x + width * width)
+
+
 # Xu, Kahraman, Anderson & Maddock (2007), J. Mech. Des. 129, 58-69: b1..b9 (REFERENCE §9).
 XU_COEFFICIENTS = (
     -8.916465,
