@@ -1,5 +1,5 @@
-"""The solver's vmap-lazy cond (``ehl._cond_any_member``): the same values as ``lax.cond``, and under
-vmap a branch that no member takes does not run. Plain ``vmap(lax.cond)`` runs both branches for
+"""The vmap-lazy cond (``jaxgear._lazy_cond.cond_any_member``, used by the EHL solver and the
+coupled model's attractor branch): the same values as ``lax.cond``, and under vmap a branch that no member takes does not run. Plain ``vmap(lax.cond)`` runs both branches for
 every member, which made a vmapped batch of 64 contacts pay for every fallback attempt (211 ms per
 contact against 21 ms solved one by one; benchmarks/ehl_kernel.py)."""
 
@@ -8,7 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxgear.lubrication.ehl import _cond_any_member
+from jaxgear._lazy_cond import cond_any_member
 
 
 def _counting():
@@ -33,20 +33,28 @@ def _counting():
     [[True, True, True], [False, False, False], [True, False, True]],
     ids=["all", "none", "some"],
 )
-def test_values_equal_lax_cond_under_vmap(pred):
+@pytest.mark.parametrize("all_true_path", [True, False])
+def test_values_equal_lax_cond_under_vmap(pred, all_true_path):
     _, expensive, cheap = _counting()
     pred = jnp.asarray(pred)
     x = jnp.asarray([0.3, 1.1, -2.0])
     k = 2.5  # an unbatched operand, broadcast by the rule
-    lazy = jax.vmap(lambda p, x: _cond_any_member(p, expensive, cheap, (x, k)))(pred, x)
+    lazy = jax.vmap(
+        lambda p, x: cond_any_member(p, expensive, cheap, (x, k), all_true_path=all_true_path)
+    )(pred, x)
     plain = jax.vmap(lambda p, x: jax.lax.cond(p, expensive, cheap, (x, k)))(pred, x)
     np.testing.assert_array_equal(np.asarray(lazy), np.asarray(plain))
 
 
-def test_untaken_branch_does_not_run_under_vmap():
+@pytest.mark.parametrize("all_true_path", [True, False])
+def test_untaken_branch_does_not_run_under_vmap(all_true_path):
     runs, expensive, cheap = _counting()
     x = jnp.asarray([0.3, 1.1, -2.0])
-    f = jax.jit(jax.vmap(lambda p, x: _cond_any_member(p, expensive, cheap, (x, 1.0))))
+    f = jax.jit(
+        jax.vmap(
+            lambda p, x: cond_any_member(p, expensive, cheap, (x, 1.0), all_true_path=all_true_path)
+        )
+    )
     jax.block_until_ready(f(jnp.zeros(3, bool), x))
     assert runs["expensive"] == 0  # no member takes it: the batch skips it
     jax.block_until_ready(f(jnp.asarray([False, True, False]), x))
@@ -62,7 +70,7 @@ def test_nested_vmap():
     runs, expensive, cheap = _counting()
     pred = jnp.asarray([[False, False], [False, True]])
     x = jnp.asarray([[0.3, 1.1], [-2.0, 0.7]])
-    f = jax.vmap(jax.vmap(lambda p, x: _cond_any_member(p, expensive, cheap, (x, 3.0))))
+    f = jax.vmap(jax.vmap(lambda p, x: cond_any_member(p, expensive, cheap, (x, 3.0))))
     out = f(pred, x)
     np.testing.assert_allclose(np.asarray(out), np.where(pred, 3.0 * np.sin(x), x), rtol=1e-15)
     runs["expensive"] = 0
@@ -75,7 +83,7 @@ def test_derivatives_are_those_of_lax_cond():
     _, expensive, cheap = _counting()
 
     def f(x, p):
-        return _cond_any_member(p, expensive, cheap, (x, 3.0))
+        return cond_any_member(p, expensive, cheap, (x, 3.0))
 
     for diff in (jax.jacfwd, jax.grad):
         assert float(diff(f)(0.4, True)) == pytest.approx(3.0 * np.cos(0.4), rel=1e-14)

@@ -31,12 +31,12 @@ import functools
 
 import equinox as eqx
 import jax
-import jax.custom_batching
 import jax.numpy as jnp
 import jax.scipy.linalg
 import numpy as np
 from jaxtyping import Array, Bool, Float, Int
 
+from .._lazy_cond import cond_any_member
 from .._validation import (
     check_choice,
     check_finite,
@@ -653,10 +653,10 @@ def _newton_direction(jac, f, lu_prev):
         jac, f, _, _ = op
         lu = jax.scipy.linalg.lu_factor(jac.astype(jnp.float32))
         d, good = _refined(jac, f, lu)
-        return _cond_any_member(good, lambda op: op[2], double, (jac, f, d)), lu
+        return cond_any_member(good, lambda op: op[2], double, (jac, f, d)), lu
 
     d, good = _refined(jac, f, lu_prev)
-    return _cond_any_member(good, lambda op: (op[3], op[2]), fresh, (jac, f, lu_prev, d))
+    return cond_any_member(good, lambda op: (op[3], op[2]), fresh, (jac, f, lu_prev, d))
 
 
 def _newton(level: _Level, u0, s, max_iter: int, tol=None):
@@ -844,63 +844,6 @@ def _warm_args(sol: EHLSolution):
     return sol.x / b, p / ph, ratio
 
 
-def _cond_any_member(pred, true_fn, false_fn, operand):
-    """``lax.cond(pred, true_fn, false_fn, operand)`` that stays lazy under ``vmap``.
-
-    A vmapped ``lax.cond`` with a batched predicate becomes a select: both branches run for every
-    member. Here, under vmap, ``false_fn`` runs (batched) only when some member's predicate is false,
-    and ``true_fn`` only when some member's is true; nested vmaps recurse. Used for the solver's
-    fallback attempts, which then cost a batch nothing when every member has converged. The
-    branches must read only ``operand`` (batched values closed over are refused by custom_vmap).
-    Differentiated, it is the plain ``lax.cond`` (and so not lazy under vmap); inside
-    ``_solve_core`` it never is, the solver's derivative being the implicit one.
-    """
-    arrays, static = eqx.partition(operand, eqx.is_array)
-    # a flat list of arrays: the JVP-of-vmap path of custom_vmap mishandles None leaves
-    leaves, treedef = jax.tree.flatten(arrays)
-
-    def branch(fn):
-        return lambda a: fn(eqx.combine(jax.tree.unflatten(treedef, a), static))
-
-    @jax.custom_batching.custom_vmap
-    def run(pred, arrays):
-        return jax.lax.cond(pred, branch(true_fn), branch(false_fn), arrays)
-
-    @run.def_vmap
-    def rule(axis_size, in_batched, pred, arrays):
-        def widen(x, batched):
-            return x if batched else jnp.broadcast_to(x, (axis_size, *jnp.shape(x)))
-
-        pred = widen(pred, in_batched[0])
-        arrays = jax.tree.map(widen, arrays, in_batched[1])
-
-        def each(pa):
-            return jax.vmap(lambda p, a: jax.lax.cond(p, branch(true_fn), branch(false_fn), a))(*pa)
-
-        def only(fn):
-            return lambda pa: jax.vmap(branch(fn))(pa[1])
-
-        some = lambda pa: _cond_any_member(jnp.any(pa[0]), each, only(false_fn), pa)  # noqa: E731
-        out = _cond_any_member(jnp.all(pred), only(true_fn), some, (pred, arrays))
-        return out, jax.tree.map(lambda _: True, out)
-
-    # Under differentiation the plain cond (custom_vmap's own JVP rule recurses without end here)
-    @jax.custom_jvp
-    def lazy(pred, leaves):
-        return run(pred, leaves)
-
-    @lazy.defjvp
-    def lazy_jvp(primals, tangents):
-        pred, leaves = primals
-        return jax.jvp(
-            lambda a: jax.lax.cond(pred, branch(true_fn), branch(false_fn), a),
-            (leaves,),
-            (tangents[1],),
-        )
-
-    return lazy(jnp.asarray(pred), leaves)
-
-
 @functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2))
 def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, init_p, init_h0):
     """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats.
@@ -924,7 +867,7 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     def attempt(carry, kind):
         u, res, it, ok, stop = carry
 
-        # The branches read only their operand (no batched value closed over): _cond_any_member.
+        # The branches read only their operand (no batched value closed over): cond_any_member.
         def cold(operand):
             kind, _, inp = operand
             row = jnp.clip(kind - 1, 0, n_cold - 1)
@@ -966,7 +909,7 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
             return operand[1], jnp.asarray(0), jnp.asarray(False)
 
         done = ok | stop
-        start, k0, repeat = _cond_any_member(done | (kind == 0), keep, cold, (kind, u, inp))
+        start, k0, repeat = cond_any_member(done | (kind == 0), keep, cold, (kind, u, inp))
         start = jnp.where(kind == 0, u_warm, start)
         budget = model.warm_iterations if warm else model.max_iterations
         max_iter = jnp.where(done, 0, jnp.where(kind == 0, budget, model.max_iterations))
@@ -1274,7 +1217,7 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
     # stops once they agree with those the film was solved with (the remaining steps are skipped by
     # lax.cond: no work when solved one contact at a time; a scan, not a while loop, so that
     # reverse-mode differentiation works). Under vmap the skipped steps still run; the vmap-lazy
-    # ``_cond_any_member`` was measured slower here (an 8-point parallel sweep, thermal transient
+    # ``cond_any_member`` was measured slower here (an 8-point parallel sweep, thermal transient
     # mixed, 32 positions × 129 nodes: 5.4-5.8 s against 4.2 s), so it is kept to the solver's
     # fallback attempts, where it pays.
     def stay(op):
