@@ -20,7 +20,13 @@ from .fidelity import Fidelity
 from .operating import OperatingPoint
 from .sweep_engine import STATUS_NAMES as POINT_STATUS_NAMES
 from .sweep_engine import run_continuation, run_points
-from .tribodynamics import STATUS_NAMES, check_inputs, cold_start, simulate_with_state
+from .tribodynamics import (
+    STATUS_ATTRACTOR,
+    STATUS_NAMES,
+    check_inputs,
+    cold_start,
+    simulate_with_state,
+)
 
 #: Inputs a sweep may vary, besides the speed.
 SWEEPABLE = (
@@ -58,7 +64,8 @@ class SweepResult(eqx.Module):
             [N, M, 2, 2]; hertz_pressure: Hertz pressure of W_T, Pa [N, M, 2] (as in SimulationResult).
         status: per point, the simulation status (0 ok; see ``tribodynamics.STATUS_NAMES``), or 5 where
             the point's chunk raised or its outputs were not finite.
-        converged: status == 0.
+        converged: status == 0; on_attractor: status 6 (no stable periodic orbit: means over the
+            attractor); failed: neither.
         messages: errors of failed chunks.
     """
 
@@ -80,6 +87,17 @@ class SweepResult(eqx.Module):
     @property
     def converged(self) -> np.ndarray:
         return np.asarray(self.status) == 0
+
+    @property
+    def on_attractor(self) -> np.ndarray:
+        """No stable periodic orbit: the point's values are means over the attractor the gears
+        settle on (status 6, ``Fidelity.attractor_periods``)."""
+        return np.asarray(self.status) == STATUS_ATTRACTOR
+
+    @property
+    def failed(self) -> np.ndarray:
+        """Neither converged nor an attractor mean: a real failure (flagged)."""
+        return ~self.converged & ~self.on_attractor
 
     def status_names(self) -> list[str]:
         names = {**STATUS_NAMES, 5: "failed (chunk raised or non-finite)"}

@@ -42,12 +42,17 @@ STATUS_FIXED_POINT = 1  # tribo-dynamic fixed point did not reach its tolerance
 STATUS_DYNAMICS = 2  # periodic orbit not converged or unstable
 STATUS_CONTACT = 3  # a contact solve did not converge
 STATUS_NON_FINITE = 4
+# Recorded attractor cycles at which the contacts are evaluated (Fidelity.attractor_periods).
+ATTRACTOR_CONTACT_CYCLES = 64
+# 5 is the sweep's own "chunk raised or non-finite" (sweep.SweepResult)
+STATUS_ATTRACTOR = 6  # no stable periodic orbit: means over the attractor reached in time
 STATUS_NAMES = {
     STATUS_OK: "ok",
     STATUS_FIXED_POINT: "tribo-dynamic fixed point not converged",
     STATUS_DYNAMICS: "dynamic periodic orbit not converged or unstable",
     STATUS_CONTACT: "contact solver not converged",
     STATUS_NON_FINITE: "non-finite result",
+    STATUS_ATTRACTOR: "no stable periodic orbit: means over the attractor (time integration)",
 }
 
 # The friction force of the formula rungs changes sign with the sliding velocity through a smooth
@@ -253,6 +258,8 @@ class SimulationResult(eqx.Module):
         friction_coefficient: per pair [M, 2]; damping: cm per pair, N s/m [M, 2].
         dynamic_te: εd(t_i), m [M]; roll_angle: gear 1 roll angle of slot 0, rad [M].
         converged: everything converged; status: 0 ok, else the first failure (see STATUS_NAMES);
+            6 (STATUS_ATTRACTOR): the fixed point has no stable periodic orbit, and the values are
+            means over the attractor the gears settle on (``Fidelity.attractor_periods``);
         fixed_point_residual: |T(y) − y| of the friction table F1 relative to its maximum, in the
             last fixed-point evaluation;
         fixed_point_iterations: iterations used (0 for quasi-static).
@@ -355,25 +362,32 @@ def _quasi_static(pair, lubricant, surfaces, op, fidelity, mesh):
     return _assemble(pair, op, mesh, forces, load, velocity, mesh.static_te, status, 0.0, 0)
 
 
+def _cycle_contacts(pair, lubricant, surfaces, op, fidelity, mesh, load, velocity, initial=None):
+    """The contacts of the cycle at tooth forces ``load`` [M, 2] and surface velocities ``velocity``
+    [M, 2, 2] (``contact_forces``)."""
+    return contact_forces(
+        pair,
+        lubricant,
+        surfaces,
+        mesh,
+        fidelity,
+        load,
+        velocity[..., 0],
+        velocity[..., 1],
+        op.inlet_temperature,
+        initial,
+        period=mesh_period(pair, op.speed_rpm),
+    )
+
+
 def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     options = _dynamics_options(fidelity)
     m = mesh.n_positions
-    period = mesh_period(pair, op.speed_rpm)
 
     def contacts_at(load, velocity, initial=None):
         """The contacts of the cycle at tooth forces ``load`` and surface velocities ``velocity``."""
-        return contact_forces(
-            pair,
-            lubricant,
-            surfaces,
-            mesh,
-            fidelity,
-            load,
-            velocity[..., 0],
-            velocity[..., 1],
-            op.inlet_temperature,
-            initial,
-            period=period,
+        return _cycle_contacts(
+            pair, lubricant, surfaces, op, fidelity, mesh, load, velocity, initial
         )
 
     def respond(interface, guess):
@@ -520,21 +534,144 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             jnp.where(forces.converged, STATUS_OK, STATUS_CONTACT),
         ),
     )
+    load, velocity, dte = state["load"], state["velocity"], state["dte"]
+    if fidelity.attractor_periods > 0:
+        forces, load, velocity, dte, status = _attractor_means(
+            pair, lubricant, surfaces, op, fidelity, mesh, state, status
+        )
     result = _assemble(
-        pair,
-        op,
-        mesh,
-        forces,
-        state["load"],
-        state["velocity"],
-        state["dte"],
-        status,
-        residual,
-        sol.stats["num_steps"],
+        pair, op, mesh, forces, load, velocity, dte, status, residual, sol.stats["num_steps"]
     )
     return result, WarmStart(
         interface=state["interface"], orbit=state["guess"], started=state["started"]
     )
+
+
+def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status):
+    """Where the fixed point ends without a stable periodic orbit (status 2, or 1 when the
+    shooting's last orbit was unstable: the fixed point cannot settle on an orbit that does not
+    exist): the means over ``fidelity.attractor_periods`` mesh cycles of the attractor the gears
+    settle on instead.
+
+    The dynamics run in time with the last interface tables (the cycle's friction and damping; a
+    table per mesh phase, so the friction does not follow each cycle's load within the
+    integration), from the unstable orbit slightly perturbed, through ``settle_periods`` cycles;
+    then the contacts are evaluated at every recorded position of ATTRACTOR_CONTACT_CYCLES cycles
+    spread over the record: exactly on the closed-form rungs (~80 µs a cycle); on the EHL rungs by
+    the closed-form mixed EHL contact scaled to the rung's level on the orbit (below), not by new
+    EHL solves. Returned per position: the means over those cycles of the contact outputs (so Φ̄
+    is the record's mean loss), tooth forces and velocities, and the DTE's mean over the whole
+    record (its mesh harmonics are the record's). Status 6 (STATUS_ATTRACTOR), or the status kept
+    where the record is not finite. No derivative passes through the attractor (its means are not
+    smooth functions of the design).
+
+    A vmap-lazy cond: a point with a stable orbit pays nothing, in a vmapped sweep too, unless
+    another point of its batch takes the branch (then every member runs it, a select)."""
+    from ._lazy_cond import cond_any_member
+    from .dynamics.model import build_dynamics
+    from .dynamics.response import DEFAULT_KICK, record_attractor
+
+    options = _dynamics_options(fidelity)
+    keys = ("forces", "load", "velocity", "dte", "interface", "guess")
+    operand = (pair, lubricant, surfaces, op, mesh, {k: state[k] for k in keys}, status)
+
+    def on_attractor(operand):
+        pair, lubricant, surfaces, op, mesh, st, status = jax.lax.stop_gradient(operand)
+        load, velocity = st["load"], st["velocity"]
+        dyn = build_dynamics(pair, op, mesh, st["interface"], options)
+        rec = record_attractor(
+            dyn,
+            mesh,
+            st["guess"],
+            options,
+            fidelity.settle_periods,
+            fidelity.attractor_periods,
+            DEFAULT_KICK,
+        )
+
+        def contacts_at(w, u):
+            return _cycle_contacts(pair, lubricant, surfaces, op, fidelity, mesh, w, u)[0]
+
+        if fidelity.uses_ehl:
+            # The closed-form mixed EHL contact (the "ehl_formula" rung) at each recorded load and
+            # velocity, scaled to this rung's level by the ratio of the two models' cycle totals
+            # on the orbit, per output (EHL solves at every recorded position would cost 64 × the
+            # fixed point's contacts; a forward-mode pass through them for power laws in the load,
+            # as the frozen coupling does, cost +80 s of compilation at the paper fidelity).
+            # Evaluated exactly, the closed form follows a rattle's loads from zero to impact
+            # (power laws from the orbit are extrapolated there, and carry no load to a slot the
+            # orbit leaves unloaded); it tracks the EHL solver's forces within 16 % at one contact
+            # (tests/test_ehl_formula.py) and Φ̄ within 6.1 % over the baseline sweep.
+            proxy_fid = fidelity.replace(friction="ehl_formula")
+            if fidelity.friction == "ehl_smooth":  # no asperity load on the smooth rung
+                surfaces = eqx.tree_at(lambda s: s.scale, surfaces, jnp.zeros_like(surfaces.scale))
+
+            def proxy(w, u):
+                return _cycle_contacts(pair, lubricant, surfaces, op, proxy_fid, mesh, w, u)[0]
+
+            on_orbit = proxy(load, velocity)
+            fields = (
+                "friction_sliding",
+                "friction_rolling",
+                "damping",
+                "power_sliding",
+                "power_rolling",
+            )
+
+            def ratio(name):
+                ehl = jnp.sum(jnp.abs(getattr(st["forces"], name)))
+                closed = jnp.sum(jnp.abs(getattr(on_orbit, name)))
+                return jnp.where(closed > 0, ehl / jnp.where(closed > 0, closed, 1.0), 0.0)
+
+            ratios = {name: ratio(name) for name in fields}
+
+            def each(w, u):
+                c = proxy(w, u)
+                scaled = {name: getattr(c, name) * ratios[name] for name in fields}
+                fs, fr = scaled["friction_sliding"], scaled["friction_rolling"]
+                loaded = w > 0
+                mu = jnp.where(
+                    loaded, _safe_sqrt(fs * fs + fr * fr) / jnp.where(loaded, w, 1.0), 0.0
+                )
+                return eqx.tree_at(
+                    lambda f: (*(getattr(f, n) for n in fields), f.friction_coefficient),
+                    c,
+                    (*scaled.values(), mu),
+                )
+
+        else:
+            each = contacts_at
+
+        # ATTRACTOR_CONTACT_CYCLES cycles spread over the whole record (the window's length, not
+        # the sample count, sets the bias of the mean), one from every block of `stride`, at a
+        # position in the block that cycles through 0..stride−1 so that a period-2, -3 or -4
+        # attractor is not sampled at one of its phases only
+        stride = max(1, fidelity.attractor_periods // ATTRACTOR_CONTACT_CYCLES)
+        k = jnp.arange(fidelity.attractor_periods // stride)
+        pick = k * stride + k % stride
+        loads, speeds = rec.tooth_force[pick], rec.surface_velocity[pick]
+        per_cycle = jax.vmap(each)(loads, speeds)
+        mean = eqx.tree_at(
+            lambda f: (f.converged, f.failed),
+            jax.tree_util.tree_map(lambda a: jnp.mean(a, axis=0), per_cycle),
+            (jnp.all(per_cycle.converged), jnp.max(per_cycle.failed)),
+        )
+        new = (mean, jnp.mean(loads, 0), jnp.mean(speeds, 0), jnp.mean(rec.dynamic_te, 0))
+        ok = rec.finite & jnp.all(
+            jnp.stack([jnp.all(jnp.isfinite(a)) for a in jax.tree_util.tree_leaves(new)])
+        )
+        old = (st["forces"], load, velocity, st["dte"])
+        picked = jax.tree_util.tree_map(lambda a, b: jnp.where(ok, a, b), new, old)
+        return picked + (jnp.where(ok, STATUS_ATTRACTOR, status).astype(status.dtype),)
+
+    def keep(operand):
+        *_, st, status = operand
+        return st["forces"], st["load"], st["velocity"], st["dte"], status
+
+    unstable = (state["dynamics_ok"] < 0.5) & jnp.all(jnp.isfinite(state["guess"]))
+    # the branch is costly to compile (the dynamics in time, and on the EHL rungs a forward-mode
+    # pass through the contacts): traced once, without the all-members path
+    return cond_any_member(unstable, on_attractor, keep, operand, all_true_path=False)
 
 
 class WarmStart(eqx.Module):
