@@ -435,7 +435,7 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
 #: Record periodicities tested by ``AttractorRecord.period`` (period-1 to period-4 orbits).
 MAX_DETECTED_PERIOD = 4
 #: A record is p-periodic when successive p-cycle blocks of εd agree to this fraction of its range
-#: (the settling's RK4 and the record's Tsit5 orbits differ by ~5e-6 of it: measured at 1500 rpm).
+#: (the record's RK4 and the shooting's Tsit5 orbits differ by ~1e-6 of it: measured at 1500 rpm).
 PERIODICITY_TOL = 1e-4
 
 
