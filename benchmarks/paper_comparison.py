@@ -25,6 +25,19 @@ PAPER_TD = {"A": 257.0, "B": 343.0, "D": 431.0, "E": 948.0}
 PAPER_QS = {"A": 276.0, "B": 302.0, "D": 526.0, "E": 532.0}
 
 
+def _bands(speeds, mask) -> str:
+    """Contiguous runs of ``speeds`` where ``mask`` holds, as "a-b, c, ..."."""
+    runs, start = [], None
+    for i, on in enumerate(list(mask) + [False]):
+        if on and start is None:
+            start = i
+        if not on and start is not None:
+            a, b = speeds[start], speeds[i - 1]
+            runs.append(f"{a:.0f}" if a == b else f"{a:.0f}-{b:.0f}")
+            start = None
+    return ", ".join(runs) or "none"
+
+
 def main(fidelity_name: str = "fast") -> None:
     fid = {"fast": jg.Fidelity.fast()}[fidelity_name]
     calibrated = getattr(jg.presets, "li2015_pair_calibrated", None)
@@ -56,8 +69,10 @@ def main(fidelity_name: str = "fast") -> None:
         "",
         f"Machine: {machine()}. Preset: {'li2015_pair_calibrated' if calibrated else 'li2015_pair'}; "
         f"fidelity {fid}. Sweep wall time (both models, with compilation): {wall:.0f} s. "
-        f"Points not converged: {int(np.sum(~td.converged))} tribo-dynamic, "
-        f"{int(np.sum(~qs.converged))} quasi-static.",
+        f"Tribo-dynamic points without a stable periodic orbit, reported as means over the "
+        f"attractor the gears settle on (status 6): {int(np.sum(td.on_attractor))} "
+        f"({_bands(speeds, td.on_attractor)} rpm). Points not converged: "
+        f"{int(np.sum(td.failed))} tribo-dynamic, {int(np.sum(~qs.converged))} quasi-static.",
         "",
         f"R1 DTE-RMS peaks: {speeds[low]:.0f} rpm ({dte[low] * 1e6:.1f} µm) and {speeds[high]:.0f} rpm "
         f"({dte[high] * 1e6:.1f} µm); paper: 1750 and 3500 rpm, the higher-speed peak much larger.",
@@ -70,8 +85,9 @@ def main(fidelity_name: str = "fast") -> None:
         a, b = float(td.power_loss[i]), float(qs.power_loss[i])
         rel = (a - b) / b
         word = "nearly equal" if abs(rel) < 0.03 else ("higher" if rel > 0 else "lower")
+        mark = " (attractor)" if td.on_attractor[i] else ""
         lines.append(
-            f"| {name} | {speeds[i]:.0f} | {a:.0f} | {PAPER_TD.get(name, '-')} | {b:.0f} | "
+            f"| {name} | {speeds[i]:.0f}{mark} | {a:.0f} | {PAPER_TD.get(name, '-')} | {b:.0f} | "
             f"{PAPER_QS.get(name, '-')} | {word} ({100 * rel:+.1f} %) | {paper_r3[name]} |"
         )
     eff = 100 * np.asarray(td.efficiency)

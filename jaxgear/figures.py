@@ -327,10 +327,16 @@ def _take(result, idx):
     return dataclasses.replace(result, **rows)
 
 
+def _usable(result):
+    """Points whose values stand: converged, or means over the attractor where no stable periodic
+    orbit exists (status 6, ``Fidelity.attractor_periods``)."""
+    return np.asarray(result.converged) | np.asarray(result.on_attractor)
+
+
 def _place_points(speeds, td):
     """Points A-E around the two DTE-RMS peaks of the sweep (REFERENCE §6), or at their nominal speeds
     when the grid cannot resolve the peaks (steps above 50 rpm or not covering 1500-3600 rpm)."""
-    dte = np.where(td.converged, np.asarray(td.dte_rms), np.nan)
+    dte = np.where(_usable(td), np.asarray(td.dte_rms), np.nan)
     steps = np.diff(speeds)
     resolved = (
         speeds.size > 10
@@ -495,19 +501,24 @@ def _mark_points(ax, repro, values, scale=1.0):
             ax.plot(repro.speeds[i], y, "o", ms=4, color="C3")
 
 
-def _flag(ax, speeds, values, ok, scale=1.0):
-    bad = ~np.asarray(ok, dtype=bool)
-    if bad.any():
-        label = "not converged (kept, flagged)"
-        ax.plot(
-            np.asarray(speeds)[bad],
-            np.asarray(values)[bad] * scale,
-            "x",
-            color="k",
-            ms=6,
-            zorder=5,
-            label=label if label not in ax.get_legend_handles_labels()[1] else None,
-        )
+def _flag(ax, speeds, values, result, scale=1.0):
+    """Mark the points of ``result`` that failed (x) and those reported as attractor means (o)."""
+    marks = (
+        (np.asarray(result.failed), "x", "not converged (kept, flagged)"),
+        (np.asarray(result.on_attractor), "o", "no stable periodic orbit (attractor mean)"),
+    )
+    for mask, marker, label in marks:
+        if mask.any():
+            ax.plot(
+                np.asarray(speeds)[mask],
+                np.asarray(values)[mask] * scale,
+                marker,
+                mfc="none",
+                color="k",
+                ms=6,
+                zorder=5,
+                label=label if label not in ax.get_legend_handles_labels()[1] else None,
+            )
 
 
 def _finish(fig, ax_list, title):
@@ -533,7 +544,7 @@ def _fig3(repro):
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(repro.speeds, 1e6 * td.dte_rms, ".-", ms=3, label="tribo-dynamic")
     _mark_points(ax, repro, td.dte_rms, 1e6)
-    _flag(ax, repro.speeds, td.dte_rms, td.converged, 1e6)
+    _flag(ax, repro.speeds, td.dte_rms, td, 1e6)
     for rpm in (1750.0, 3500.0):
         ax.axvline(rpm, color="0.6", lw=0.8, ls=":", label="paper's peaks" if rpm < 2000 else None)
     ax.set(xlabel="gear 1 speed (rpm)", ylabel="(εd)rms (µm)")
@@ -556,7 +567,7 @@ def _fig4(repro):
     for key, ls in (("total", "-"), ("sliding", "--"), ("rolling", ":")):
         a.plot(repro.speeds, _parts(td)[key], ls, color="C0", label=f"{key}, tribo-dynamic")
         a.plot(repro.speeds, _parts(qs)[key], ls, color="C1", label=f"{key}, quasi-static")
-    _flag(a, repro.speeds, td.power_loss, td.converged)
+    _flag(a, repro.speeds, td.power_loss, td)
     _mark_points(a, repro, td.power_loss)
     if not repro.fidelity.models_rolling:
         a.text(
@@ -572,7 +583,7 @@ def _fig4(repro):
     b.plot(repro.speeds, 100 * td.efficiency, "-", label="tribo-dynamic")
     b.plot(repro.speeds, 100 * qs.efficiency, "--", label="quasi-static")
     b.axhspan(99.6, 99.85, color="0.9", label="paper's band (R4)")
-    _flag(b, repro.speeds, td.efficiency, td.converged, 100)
+    _flag(b, repro.speeds, td.efficiency, td, 100)
     b.set(xlabel="gear 1 speed (rpm)", ylabel="Ψ (%)", title="(b) mesh efficiency")
     b.legend(fontsize=8)
     return _finish(fig, [a, b], f"Fig. 4: power loss and efficiency\n{_subtitle(repro)}")
@@ -587,7 +598,7 @@ def _fig5(repro):
         qs = repro.quasi_static.power_loss_position[i]
         ax.plot(roll, td, "-", label="tribo-dynamic")
         ax.plot(roll, qs, "--", label="quasi-static")
-        flag = "" if repro.tribo_dynamic.converged[i] else " (not converged)"
+        flag = _mark(repro.tribo_dynamic, i, " (attractor mean)", " (not converged)")
         ax.set(
             title=f"{name}: {repro.speeds[i]:.0f} rpm{flag}",
             xlabel="roll angle of the entering pair (°)",
@@ -614,9 +625,9 @@ def _compare(repro, number, key, label_base, label_variant, what):
         a.plot(v, parts["total"], "-", color=color, label=f"total, {label}")
         a.plot(v, parts["sliding"], "--", color=color, label=f"sliding, {label}")
         a.plot(v, parts["rolling"], ":", color=color, label=f"rolling, {label}")
-        _flag(a, v, res.power_loss, res.converged)
+        _flag(a, v, res.power_loss, res)
         b.plot(v, 100 * res.efficiency, "-", color=color, label=label)
-        _flag(b, v, res.efficiency, res.converged, 100)
+        _flag(b, v, res.efficiency, res, 100)
     a.set(xlabel="gear 1 speed (rpm)", ylabel="Φ̄ (W)", title="(a) mesh power loss")
     a.legend(fontsize=7, ncol=2)
     b.set(xlabel="gear 1 speed (rpm)", ylabel="Ψ (%)", title="(b) mesh efficiency")
@@ -792,13 +803,20 @@ def _not_evaluated(rid, reason):
     return _row(rid, "not evaluated", None, reason)
 
 
+def _mark(result, i, attractor="‡", failed="†"):
+    """The flag of point ``i``: none when converged, ``attractor`` for a mean over the attractor
+    (no stable periodic orbit), ``failed`` otherwise."""
+    if bool(result.converged[i]):
+        return ""
+    return attractor if bool(result.on_attractor[i]) else failed
+
+
 def _at(result, i):
-    flag = "" if bool(result.converged[i]) else "†"
-    return f"{float(result.power_loss[i]):.0f}{flag}"
+    return f"{float(result.power_loss[i]):.0f}{_mark(result, i)}"
 
 
 def _ok_both(a, b):
-    return np.asarray(a.converged) & np.asarray(b.converged)
+    return _usable(a) & _usable(b)
 
 
 def paper_table(repro: PaperReproduction) -> list[dict]:
@@ -811,7 +829,7 @@ def paper_table(repro: PaperReproduction) -> list[dict]:
 
     # R1
     if repro.points_source == "peaks":
-        dte = np.where(td.converged, td.dte_rms, np.nan)
+        dte = np.where(_usable(td), td.dte_rms, np.nan)
         low = int(np.nanargmax(np.where(repro.speeds < repro.point_speed("C"), dte, np.nan)))
         high = P["E"]
         lo_rpm, hi_rpm = repro.speeds[low], repro.speeds[high]
@@ -827,7 +845,7 @@ def paper_table(repro: PaperReproduction) -> list[dict]:
                 f"({1e6 * dte[high]:.1f} µm)",
                 bool(ok),
                 "criterion: peaks within 150 rpm of 1750 and 200 rpm of 3500, the higher one "
-                "> 1.2× the lower (converged points only)",
+                "> 1.2× the lower (converged points and attractor means)",
             )
         )
     else:
@@ -864,7 +882,7 @@ def paper_table(repro: PaperReproduction) -> list[dict]:
         rel = (float(td.power_loss[i]) - float(qs.power_loss[i])) / float(qs.power_loss[i])
         word = "nearly equal" if abs(rel) < NEARLY_EQUAL else ("higher" if rel > 0 else "lower")
         agree &= word == PAPER_R3[k]
-        flag = "" if bool(td.converged[i]) else "†"
+        flag = _mark(td, i)
         words.append(f"{k} {word} ({100 * rel:+.1f} %){flag}")
     rows.append(
         _row(
@@ -876,19 +894,19 @@ def paper_table(repro: PaperReproduction) -> list[dict]:
     )
 
     # R4
-    eff = 100 * np.asarray(td.efficiency)[td.converged]
+    eff = 100 * np.asarray(td.efficiency)[_usable(td)]
     if eff.size:
         rows.append(
             _row(
                 "R4",
-                f"Ψ {eff.min():.3f}-{eff.max():.3f} % over {eff.size} converged speeds "
+                f"Ψ {eff.min():.3f}-{eff.max():.3f} % over {eff.size} usable speeds "
                 f"({repro.speeds[0]:.0f}-{repro.speeds[-1]:.0f} rpm)",
                 bool(eff.min() >= 99.6 and eff.max() <= 99.85),
-                "criterion: every converged speed inside 99.6-99.85 %",
+                "criterion: every usable speed (converged or attractor mean) inside 99.6-99.85 %",
             )
         )
     else:
-        rows.append(_not_evaluated("R4", "no converged speed"))
+        rows.append(_not_evaluated("R4", "no usable speed"))
 
     # R5
     if "isothermal" in repro.variants:
@@ -902,7 +920,7 @@ def paper_table(repro: PaperReproduction) -> list[dict]:
                 "R5",
                 f"(Φ̄_iso − Φ̄_thermal)/Φ̄_thermal from {100 * g[0]:+.1f} % to {100 * g[-1]:+.1f} %"
                 if g.size
-                else "no converged common speed",
+                else "no usable common speed",
                 agrees if g.size else None,
                 "criterion: iso-thermal above thermal at every speed, gap larger at the highest "
                 "speed than at the lowest",
@@ -926,7 +944,7 @@ def paper_table(repro: PaperReproduction) -> list[dict]:
             )
         )
     else:
-        ok = np.asarray(td.converged)
+        ok = _usable(td)
         share = np.asarray(td.power_loss_rolling) / np.asarray(td.power_loss)
         s = share[ok]
         if s.size >= 2:
@@ -942,7 +960,7 @@ def paper_table(repro: PaperReproduction) -> list[dict]:
                 )
             )
         else:
-            rows.append(_not_evaluated("R9", "fewer than two converged speeds"))
+            rows.append(_not_evaluated("R9", "fewer than two usable speeds"))
 
     # R10
     g, p = repro.fields.get("fig12_ground"), repro.fields.get("fig12_polished")
@@ -1015,7 +1033,7 @@ def _variant_row(repro, rid, key, name, base_name):
     base, var = repro.variants["baseline"], repro.variants[key]
     ok = _ok_both(base, var)
     if not ok.any():
-        return _not_evaluated(rid, "no speed converged in both runs")
+        return _not_evaluated(rid, "no usable speed in both runs")
     lb, lv = np.asarray(base.power_loss)[ok], np.asarray(var.power_loss)[ok]
     eb, ev = 100 * np.asarray(base.efficiency)[ok], 100 * np.asarray(var.efficiency)[ok]
     ratio = float(np.mean(lv / lb))
@@ -1026,7 +1044,7 @@ def _variant_row(repro, rid, key, name, base_name):
     )
     if rid == "R6":
         agrees = bool(np.all(lv < lb) and np.all(ev > eb))
-        crit = "criterion: lower Φ̄ and higher Ψ at every converged speed"
+        crit = "criterion: lower Φ̄ and higher Ψ at every usable speed"
     elif rid == "R7":
         agrees = bool(ratio > 1.5 and np.all(ev < eb) and d_eff > -0.1)
         crit = (
@@ -1034,7 +1052,7 @@ def _variant_row(repro, rid, key, name, base_name):
         )
     else:
         agrees = bool(ratio < 0.8 and np.all(ev > eb))
-        crit = "criterion: Φ̄ ratio < 0.8; Ψ higher at every converged speed"
+        crit = "criterion: Φ̄ ratio < 0.8; Ψ higher at every usable speed"
     return _row(rid, text, agrees, crit)
 
 
@@ -1065,7 +1083,8 @@ def write_report(repro: PaperReproduction, out_dir: str | Path) -> dict:
         f"# The paper's results (S. Li 2015, REFERENCE §7) beside jaxgear\n\n"
         f"{_subtitle(repro)}; points A-E "
         + ", ".join(f"{k} {repro.point_speed(k):.0f} rpm" for k in repro.points)
-        + f" ({repro.points_source}). † = not converged (kept, flagged).\n\n"
+        + f" ({repro.points_source}). † = not converged (kept, flagged); ‡ = no stable periodic "
+        "orbit, mean over the attractor (status 6).\n\n"
     )
     (out / "paper_table.md").write_text(header + table_markdown(rows) + "\n")
     data = out / "data"
@@ -1089,6 +1108,7 @@ def write_report(repro: PaperReproduction, out_dir: str | Path) -> dict:
             k: {
                 "speed_rpm": repro.point_speed(k),
                 "converged": bool(repro.tribo_dynamic.converged[i]),
+                "attractor_mean": bool(repro.tribo_dynamic.on_attractor[i]),
             }
             for k, i in repro.points.items()
         },
@@ -1098,8 +1118,12 @@ def write_report(repro: PaperReproduction, out_dir: str | Path) -> dict:
         "tables": ["paper_table.md", "paper_table.json"],
         "data": [f"data/{p.name}" for p in csvs],
         "timings_s": repro.timings,
+        "on_attractor": {
+            name: int(np.sum(np.asarray(r.on_attractor)))
+            for name, r in [("tribo_dynamic", repro.tribo_dynamic)] + list(repro.variants.items())
+        },
         "not_converged": {
-            name: int(np.sum(~np.asarray(r.converged)))
+            name: int(np.sum(np.asarray(r.failed)))
             for name, r in [
                 ("tribo_dynamic", repro.tribo_dynamic),
                 ("quasi_static", repro.quasi_static),

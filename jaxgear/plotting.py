@@ -76,29 +76,38 @@ def _paper_points(ax, ymax=None):
         ax.axvline(rpm, color="0.7", lw=0.8, ls=":")
 
 
-def _mark_flagged(ax, speeds_rpm, values, ok):
-    """Points whose solution did not converge (e.g. no stable periodic orbit) as red crosses."""
+def _mark_flagged(ax, speeds_rpm, values, ok, attractor=None):
+    """Points whose solution did not converge as red crosses; ``attractor`` (a mask): points
+    without a stable periodic orbit, whose values are means over the attractor, as open circles."""
+    speeds, values = np.asarray(speeds_rpm), np.asarray(values)
+    if attractor is not None and np.asarray(attractor, dtype=bool).any():
+        on = np.asarray(attractor, dtype=bool)
+        ax.plot(
+            speeds[on],
+            values[on],
+            "o",
+            mfc="none",
+            color="C2",
+            ms=5,
+            label="no stable periodic orbit (attractor mean)",
+        )
     if ok is None:
         return
     bad = ~np.asarray(ok, dtype=bool)
     if bad.any():
-        ax.plot(
-            np.asarray(speeds_rpm)[bad],
-            np.asarray(values)[bad],
-            "x",
-            color="C3",
-            ms=5,
-            label="not converged (flagged)",
-        )
+        ax.plot(speeds[bad], values[bad], "x", color="C3", ms=5, label="not converged (flagged)")
 
 
-def plot_dte_rms(speeds_rpm, dte_rms, path, *, label="tribo-dynamic", others=(), ok=None):
+def plot_dte_rms(
+    speeds_rpm, dte_rms, path, *, label="tribo-dynamic", others=(), ok=None, attractor=None
+):
     """RMS dynamic transmission error (first 10 mesh harmonics) against speed, like the paper's Fig. 3.
-    ``ok``: per-speed convergence flags; flagged speeds are marked."""
+    ``ok``: per-speed flags, False where a point failed (marked); ``attractor``: points whose values
+    are means over an attractor (no stable periodic orbit), marked apart."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(speeds_rpm, np.asarray(dte_rms) * 1e6, ".-", ms=3, label=label)
-    _mark_flagged(ax, speeds_rpm, np.asarray(dte_rms) * 1e6, ok)
+    _mark_flagged(ax, speeds_rpm, np.asarray(dte_rms) * 1e6, ok, attractor)
     for other_label, values in others:
         ax.plot(speeds_rpm, np.asarray(values) * 1e6, "--", label=other_label)
     _paper_points(ax)
@@ -111,7 +120,7 @@ def plot_dte_rms(speeds_rpm, dte_rms, path, *, label="tribo-dynamic", others=(),
     return Path(path)
 
 
-def plot_power_loss(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=None):
+def plot_power_loss(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=None, attractor=None):
     """Cycle-mean power loss against speed: sliding, rolling and total, tribo-dynamic against
     quasi-static (like the paper's Fig. 4a). ``dynamic``/``quasi_static``: dicts with keys
     "total", "sliding", "rolling" (W); ``quasi_static`` may be None (one model only). ``labels``:
@@ -124,7 +133,7 @@ def plot_power_loss(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=Non
         ax.plot(speeds_rpm, dynamic[key], ls, color="C0", label=f"{key}, {first}")
         if quasi_static is not None:
             ax.plot(speeds_rpm, quasi_static[key], ls, color="C1", label=f"{key}, {second}")
-    _mark_flagged(ax, speeds_rpm, dynamic["total"], ok)
+    _mark_flagged(ax, speeds_rpm, dynamic["total"], ok, attractor)
     _paper_points(ax)
     ax.set(xlabel="gear 1 speed (rpm)", ylabel="Φ̄ (W)", title="Mesh power loss")
     ax.grid(alpha=0.3)
@@ -135,7 +144,7 @@ def plot_power_loss(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=Non
     return Path(path)
 
 
-def plot_efficiency(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=None):
+def plot_efficiency(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=None, attractor=None):
     """Mesh efficiency Ψ (%) against speed, tribo-dynamic against quasi-static (paper's Fig. 4b);
     ``quasi_static`` may be None. ``labels``: names of the two models."""
     plt = _pyplot()
@@ -144,7 +153,7 @@ def plot_efficiency(speeds_rpm, dynamic, quasi_static, path, ok=None, labels=Non
     ax.plot(speeds_rpm, 100 * np.asarray(dynamic), "-", label=first)
     if quasi_static is not None:
         ax.plot(speeds_rpm, 100 * np.asarray(quasi_static), "--", label=second)
-    _mark_flagged(ax, speeds_rpm, 100 * np.asarray(dynamic), ok)
+    _mark_flagged(ax, speeds_rpm, 100 * np.asarray(dynamic), ok, attractor)
     _paper_points(ax)
     ax.set(xlabel="gear 1 speed (rpm)", ylabel="Ψ (%)", title="Mesh efficiency")
     ax.grid(alpha=0.3)

@@ -124,14 +124,17 @@ def run(args: argparse.Namespace) -> int:
     t_all = time.perf_counter() - t0
 
     _write_csv(out / "sweep.csv", speeds, td, qs)
-    plot_dte_rms(speeds, td.dte_rms, out / "dte_rms.png", ok=td.converged)
+    ok, att = ~td.failed, td.on_attractor
+    plot_dte_rms(speeds, td.dte_rms, out / "dte_rms.png", ok=ok, attractor=att)
     parts = lambda r: {
         "total": r.power_loss,
         "sliding": r.power_loss_sliding,
         "rolling": r.power_loss_rolling,
     }
-    plot_power_loss(speeds, parts(td), parts(qs), out / "power_loss.png", ok=td.converged)
-    plot_efficiency(speeds, td.efficiency, qs.efficiency, out / "efficiency.png", ok=td.converged)
+    plot_power_loss(speeds, parts(td), parts(qs), out / "power_loss.png", ok=ok, attractor=att)
+    plot_efficiency(
+        speeds, td.efficiency, qs.efficiency, out / "efficiency.png", ok=ok, attractor=att
+    )
     summary = _summary(speeds, td, qs, fid, args, t_td, t_all)
     if reasons:
         summary["inputs"]["fidelity_reasons"] = reasons
@@ -141,11 +144,18 @@ def run(args: argparse.Namespace) -> int:
         f"wrote {out / 'sweep.csv'}, {out / 'summary.json'}, dte_rms.png, power_loss.png, "
         f"efficiency.png in {out}"
     )
+    on = summary["headline"]["points_on_attractor"]
+    if on:
+        print(
+            f"{on} of {len(speeds)} speeds have no stable periodic orbit (parametric instability "
+            "or rattling): their values are means over the attractor the gears settle on "
+            "(status 6 in sweep.csv; listed in summary.json)"
+        )
     bad = summary["headline"]["points_not_converged"]
     if bad:
         print(
             f"{bad} of {len(speeds)} speeds did not converge (kept, flagged in sweep.csv and "
-            "summary.json: e.g. no stable periodic orbit where the teeth rattle)"
+            "summary.json)"
         )
     return 0
 
@@ -201,7 +211,7 @@ def _peak(speeds, values, lo, hi):
 
 
 def _summary(speeds, td, qs, fid, args, t_td, t_all):
-    ok = td.converged
+    ok = ~td.failed
     return {
         "headline": {
             "speeds_rpm": [float(speeds[0]), float(speeds[-1]), len(speeds)],
@@ -211,6 +221,7 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
             "dte_rms_peak_low": _peak(speeds, td.dte_rms, 0, 2600),
             "dte_rms_peak_high": _peak(speeds, td.dte_rms, 2600, 1e9),
             "points_not_converged": int(np.sum(~ok)),
+            "points_on_attractor": int(np.sum(td.on_attractor)),
             "wall_time_s": round(t_all, 2),
         },
         "inputs": {
@@ -237,4 +248,5 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
             for s, name, good in zip(speeds, td.status_names(), ok)
             if not good
         ],
+        "on_attractor": [float(s) for s, on in zip(speeds, td.on_attractor) if on],
     }

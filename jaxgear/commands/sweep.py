@@ -113,16 +113,18 @@ def _plots(speeds, main, reference, dynamics, out):
         "sliding": r.power_loss_sliding,
         "rolling": r.power_loss_rolling,
     }
-    ok = main.converged
-    paths = [plot_dte_rms(speeds, main.dte_rms, out / "dte_rms.png", label=label, ok=ok)]
+    ok, att = ~main.failed, main.on_attractor
+    paths = [
+        plot_dte_rms(speeds, main.dte_rms, out / "dte_rms.png", label=label, ok=ok, attractor=att)
+    ]
     ref_parts = parts(reference) if reference is not None else None
     labels = (label, "quasi-static")
     paths.append(
-        plot_power_loss(speeds, parts(main), ref_parts, out / "power_loss.png", ok, labels)
+        plot_power_loss(speeds, parts(main), ref_parts, out / "power_loss.png", ok, labels, att)
     )
     ref_eff = reference.efficiency if reference is not None else None
     paths.append(
-        plot_efficiency(speeds, main.efficiency, ref_eff, out / "efficiency.png", ok, labels)
+        plot_efficiency(speeds, main.efficiency, ref_eff, out / "efficiency.png", ok, labels, att)
     )
     return paths
 
@@ -130,7 +132,7 @@ def _plots(speeds, main, reference, dynamics, out):
 def _summary(cfg, main, reference, t_main, t_all):
     speeds = cfg.speeds
     eff = 100 * np.asarray(main.efficiency)
-    ok = main.converged
+    ok = ~main.failed
     fid = cfg.fidelity
     summary = {
         "headline": {
@@ -141,6 +143,7 @@ def _summary(cfg, main, reference, t_main, t_all):
             "max_power_loss_W": _nan_stat(np.nanmax, main.power_loss),
             "max_dte_rms_um": _nan_stat(np.nanmax, 1e6 * np.asarray(main.dte_rms)),
             "points_not_converged": int(np.sum(~ok)),
+            "points_on_attractor": int(np.sum(main.on_attractor)),
             "wall_time_s": round(t_all, 2),
         },
         "inputs": cfg.echo,
