@@ -184,7 +184,11 @@ TRIBO_POINTS = [
 ]
 
 
-@pytest.mark.parametrize("friction", ["regression", "ehl_formula"])
+@pytest.mark.parametrize(
+    "friction",
+    # the fast preset's rung by default; the regression rung (also in the slow corners) is slow
+    [pytest.param("regression", marks=pytest.mark.slow), "ehl_formula"],
+)
 def test_tribo_dynamic_extremes_and_resonance(friction):
     fid = jg.Fidelity(friction=friction)
     inputs = points(*TRIBO_POINTS)

@@ -56,7 +56,9 @@ def test_frozen_equals_fixed_point_for_constant_mu(setup):
     assert float(frozen.power_loss) == pytest.approx(float(full.power_loss), rel=1e-3)
 
 
+@pytest.mark.slow
 def test_frozen_power_law_follows_a_fresh_solve_at_another_load(setup):
+    # slow (~1 min): the default run keeps the frozen rung's exactness check for a constant μ
     # The frozen coefficients at 0.7 and 1.3 × the static loads (same velocities) against the EHL
     # contacts solved afresh at those loads: statistical mixed, iso-thermal, quasi-steady, 24 × 65,
     # 2500 rpm. Errors: the largest entry's difference relative to the largest fresh entry.
