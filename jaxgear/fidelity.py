@@ -100,13 +100,15 @@ class Fidelity(eqx.Module):
             settle on another attractor (a period-doubled orbit, a torus, a chaotic rattle): the
             result is then the mean over this many mesh cycles of that attractor, reached by time
             integration with the last interface tables (``jaxgear.dynamics.attractor_response``),
-            with the contacts evaluated at every position of 64 cycles spread over the record
-            (status 6, "attractor"; on the EHL rungs through the closed-form mixed EHL contact
-            scaled to the rung's level on the orbit: see ``tribodynamics._attractor_means``).
+            with the contacts evaluated at every position of every recorded cycle (status 6,
+            "attractor"; on the EHL rungs through the closed-form mixed EHL contact scaled to the
+            rung's level on the orbit: see ``tribodynamics._attractor_means``).
             0: report the unstable periodic orbit, flagged (status 2), as before. Default 256:
             the mean mesh force of the chaotic rattles of the calibrated pair comes within 2 % of
             T1/rb1 (its exact long-time mean) over 256 cycles, against 4-11 % over 32 (the
-            window's start and end momenta). Integer ≥ 0 (not 1).
+            window's start and end momenta). In a continuation sweep the next speed without a
+            stable orbit continues from this record's end (ATTRACTOR_WARM_SETTLE = 200 settling
+            cycles instead of ``settle_periods``). Integer ≥ 0 (not 1).
         settle_periods: mesh cycles integrated before the record (re-balancing the load torque so
             that the mean speed stays nominal). A weak instability (largest Floquet multiplier
             1 + ε) leaves the orbit over ~ln(1e3)/ε cycles: 2000 covers ε ≳ 0.004; weaker ones stay

@@ -42,10 +42,11 @@ STATUS_FIXED_POINT = 1  # tribo-dynamic fixed point did not reach its tolerance
 STATUS_DYNAMICS = 2  # periodic orbit not converged or unstable
 STATUS_CONTACT = 3  # a contact solve did not converge
 STATUS_NON_FINITE = 4
-# Recorded attractor cycles at which the contacts are evaluated (Fidelity.attractor_periods).
-ATTRACTOR_CONTACT_CYCLES = 64
 # 5 is the sweep's own "chunk raised or non-finite" (sweep.SweepResult)
 STATUS_ATTRACTOR = 6  # no stable periodic orbit: means over the attractor reached in time
+# Settling cycles of an attractor continued from the previous speed's (continuation sweeps): the
+# attractor moves little between neighbouring speeds (measured: see tests/test_attractor.py).
+ATTRACTOR_WARM_SETTLE = 200
 STATUS_NAMES = {
     STATUS_OK: "ok",
     STATUS_FIXED_POINT: "tribo-dynamic fixed point not converged",
@@ -535,19 +536,25 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         ),
     )
     load, velocity, dte = state["load"], state["velocity"], state["dte"]
+    attractor, on_attractor = jnp.zeros(13, dtype=zeros.dtype), jnp.zeros((), dtype=zeros.dtype)
     if fidelity.attractor_periods > 0:
-        forces, load, velocity, dte, status = _attractor_means(
-            pair, lubricant, surfaces, op, fidelity, mesh, state, status
+        warm_attractor = (warm.attractor, warm.on_attractor)
+        forces, load, velocity, dte, status, (attractor, on_attractor) = _attractor_means(
+            pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
         )
     result = _assemble(
         pair, op, mesh, forces, load, velocity, dte, status, residual, sol.stats["num_steps"]
     )
     return result, WarmStart(
-        interface=state["interface"], orbit=state["guess"], started=state["started"]
+        interface=state["interface"],
+        orbit=state["guess"],
+        started=state["started"],
+        attractor=attractor,
+        on_attractor=on_attractor,
     )
 
 
-def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status):
+def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm):
     """Where the fixed point ends without a stable periodic orbit (status 2, or 1 when the
     shooting's last orbit was unstable: the fixed point cannot settle on an orbit that does not
     exist): the means over ``fidelity.attractor_periods`` mesh cycles of the attractor the gears
@@ -556,14 +563,18 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     The dynamics run in time with the last interface tables (the cycle's friction and damping; a
     table per mesh phase, so the friction does not follow each cycle's load within the
     integration), from the unstable orbit slightly perturbed, through ``settle_periods`` cycles;
-    then the contacts are evaluated at every recorded position of ATTRACTOR_CONTACT_CYCLES cycles
-    spread over the record: exactly on the closed-form rungs (~80 µs a cycle); on the EHL rungs by
-    the closed-form mixed EHL contact scaled to the rung's level on the orbit (below), not by new
-    EHL solves. Returned per position: the means over those cycles of the contact outputs (so Φ̄
-    is the record's mean loss), tooth forces and velocities, and the DTE's mean over the whole
+    then the contacts are evaluated at every recorded position of every cycle: exactly on the
+    closed-form rungs (~80 µs a cycle); on the EHL rungs by the closed-form mixed EHL contact
+    scaled to the rung's level on the orbit (below), not by new EHL solves. Returned per position:
+    the means over the record of the contact outputs (so Φ̄ is the record's mean loss), tooth forces and velocities, and the DTE's mean over the whole
     record (its mesh harmonics are the record's). Status 6 (STATUS_ATTRACTOR), or the status kept
     where the record is not finite. No derivative passes through the attractor (its means are not
     smooth functions of the design).
+
+    ``warm``: (state [13], flag) of the previous point's attractor in a continuation sweep; where
+    the flag is 1 the record starts from it, with ATTRACTOR_WARM_SETTLE cycles and no kick (the
+    paper's stepwise speed increase: the gears carry their motion from speed to speed). Returns,
+    besides the means, the (state, flag) to hand to the next point.
 
     A vmap-lazy cond: a point with a stable orbit pays nothing, in a vmapped sweep too, unless
     another point of its batch takes the branch (then every member runs it, a select)."""
@@ -573,20 +584,25 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
 
     options = _dynamics_options(fidelity)
     keys = ("forces", "load", "velocity", "dte", "interface", "guess")
-    operand = (pair, lubricant, surfaces, op, mesh, {k: state[k] for k in keys}, status)
+    operand = (pair, lubricant, surfaces, op, mesh, {k: state[k] for k in keys}, status, warm)
 
     def on_attractor(operand):
-        pair, lubricant, surfaces, op, mesh, st, status = jax.lax.stop_gradient(operand)
+        pair, lubricant, surfaces, op, mesh, st, status, warm = jax.lax.stop_gradient(operand)
         load, velocity = st["load"], st["velocity"]
         dyn = build_dynamics(pair, op, mesh, st["interface"], options)
+        continued = warm[1] > 0.5
         rec = record_attractor(
             dyn,
             mesh,
-            st["guess"],
+            jnp.where(continued, warm[0], st["guess"]),
             options,
-            fidelity.settle_periods,
+            jnp.where(
+                continued,
+                min(ATTRACTOR_WARM_SETTLE, fidelity.settle_periods),
+                fidelity.settle_periods,
+            ),
             fidelity.attractor_periods,
-            DEFAULT_KICK,
+            jnp.where(continued, 0.0, DEFAULT_KICK),
         )
 
         def contacts_at(w, u):
@@ -642,14 +658,8 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         else:
             each = contacts_at
 
-        # ATTRACTOR_CONTACT_CYCLES cycles spread over the whole record (the window's length, not
-        # the sample count, sets the bias of the mean), one from every block of `stride`, at a
-        # position in the block that cycles through 0..stride−1 so that a period-2, -3 or -4
-        # attractor is not sampled at one of its phases only
-        stride = max(1, fidelity.attractor_periods // ATTRACTOR_CONTACT_CYCLES)
-        k = jnp.arange(fidelity.attractor_periods // stride)
-        pick = k * stride + k % stride
-        loads, speeds = rec.tooth_force[pick], rec.surface_velocity[pick]
+        # every recorded cycle (closed forms on every rung: ~80 µs a cycle)
+        loads, speeds = rec.tooth_force, rec.surface_velocity
         per_cycle = jax.vmap(each)(loads, speeds)
         mean = eqx.tree_at(
             lambda f: (f.converged, f.failed),
@@ -662,11 +672,15 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         )
         old = (st["forces"], load, velocity, st["dte"])
         picked = jax.tree_util.tree_map(lambda a, b: jnp.where(ok, a, b), new, old)
-        return picked + (jnp.where(ok, STATUS_ATTRACTOR, status).astype(status.dtype),)
+        end = jnp.concatenate([rec.final_state, rec.load_torque_correction[None]])
+        handover = (jnp.where(ok, end, 0.0), jnp.where(ok, 1.0, 0.0).astype(end.dtype))
+        status = jnp.where(ok, STATUS_ATTRACTOR, status).astype(status.dtype)
+        return (*picked, status, handover)
 
     def keep(operand):
-        *_, st, status = operand
-        return st["forces"], st["load"], st["velocity"], st["dte"], status
+        *_, st, status, warm = operand
+        off = (jnp.zeros_like(warm[0]), jnp.zeros_like(warm[1]))
+        return st["forces"], st["load"], st["velocity"], st["dte"], status, off
 
     unstable = (state["dynamics_ok"] < 0.5) & jnp.all(jnp.isfinite(state["guess"]))
     # the branch is costly to compile (the dynamics in time, and on the EHL rungs a forward-mode
@@ -678,20 +692,24 @@ class WarmStart(eqx.Module):
     """A converged tribo-dynamic state to start a neighbouring point from (continuation sweeps).
 
     ``started`` is 1 when ``orbit`` is a periodic orbit to shoot from, 0 for a cold start
-    (``cold_start``): then the orbit is ignored and the tables are zero."""
+    (``cold_start``): then the orbit is ignored and the tables are zero. ``attractor``: the state
+    [12] and load-torque correction at the end of the point's attractor record, valid when
+    ``on_attractor`` is 1: the next speed, if it has no stable orbit either, continues from it
+    (the paper's stepwise speed increase), with ATTRACTOR_WARM_SETTLE settling cycles and no kick."""
 
     interface: MeshInterface
     orbit: Float[Array, " 13"]
     started: Float[Array, ""]
+    attractor: Float[Array, " 13"]
+    on_attractor: Float[Array, ""]
 
 
 def cold_start(n_positions: int, dtype=jnp.float64) -> WarmStart:
     """The WarmStart equivalent to no warm start: a continuation sweep's first point runs through the
     same compiled step as the others (one compilation instead of two)."""
     zeros = jnp.zeros((n_positions, 2), dtype=dtype)
-    return WarmStart(
-        MeshInterface(zeros, zeros, zeros), jnp.zeros(13, dtype=dtype), jnp.zeros((), dtype=dtype)
-    )
+    none, no = jnp.zeros(13, dtype=dtype), jnp.zeros((), dtype=dtype)
+    return WarmStart(MeshInterface(zeros, zeros, zeros), none, no, none, no)
 
 
 def simulate_with_state(pair, lubricant, surfaces, op, fidelity, warm: WarmStart | None = None):

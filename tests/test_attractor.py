@@ -98,9 +98,17 @@ def test_chaotic_rattle_keeps_the_moment_balance_over_the_record():
     assert float(jnp.mean(att.mesh_force)) == pytest.approx(T1_OVER_RB1, rel=0.02)
 
 
-def test_simulate_reports_means_over_the_attractor_where_no_orbit_is_stable():
+@pytest.fixture(scope="module")
+def at_3450():
+    """The coupled model at 3450 rpm (default fidelity): result and WarmStart."""
+    from jaxgear.tribodynamics import simulate_with_state
+
     lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
-    res = jg.simulate(PAIR, lub, surf, _op(3450.0), jg.Fidelity())
+    return simulate_with_state(PAIR, lub, surf, _op(3450.0), jg.Fidelity())
+
+
+def test_simulate_reports_means_over_the_attractor_where_no_orbit_is_stable(at_3450):
+    res = at_3450[0]
     assert int(res.status) == STATUS_ATTRACTOR, STATUS_NAMES[int(res.status)]
     assert not bool(res.converged)
     values = [res.power_loss, res.efficiency, res.dte_rms, res.tooth_force, res.power_loss_position]
@@ -109,6 +117,34 @@ def test_simulate_reports_means_over_the_attractor_where_no_orbit_is_stable():
     # measured −0.4 %
     assert float(res.tooth_force.sum(1).mean()) == pytest.approx(T1_OVER_RB1, rel=0.03)
     assert 0.0 < float(res.power_loss) < 0.01 * 700.0 * float(_op(3450.0).omega1)
+
+
+def test_a_continuation_sweep_carries_the_attractor_to_the_next_speed(at_3450):
+    """The paper's stepwise speed increase: a point with no stable orbit hands the end of its
+    record to the next (``WarmStart.attractor``), which settles from it for ATTRACTOR_WARM_SETTLE
+    cycles instead of ``settle_periods`` from a kicked orbit. Checked against what it did not
+    produce: the same speed settled cold. Where the attractor is periodic (a rattle locked to the
+    mesh: 3375-3550 rpm at ``Fidelity.fast()``) both starts reach the same record, measured 0.0 %
+    apart; at the default fidelity it is not periodic there, and the two records are different
+    windows of one attractor (measured at 3475 and 3500 rpm: Φ̄ +0.7 %, +0.4 %; DTE RMS −1.8 %,
+    −2.2 %).
+    """
+    from jaxgear.tribodynamics import ATTRACTOR_WARM_SETTLE, simulate_with_state
+
+    lub, surf, fid = jg.presets.mil_l_23699(), jg.presets.ground(), jg.Fidelity()
+    assert ATTRACTOR_WARM_SETTLE < fid.settle_periods
+    first, warm = at_3450
+    assert int(first.status) == STATUS_ATTRACTOR and float(warm.on_attractor) == 1.0
+    assert bool(jnp.all(jnp.isfinite(warm.attractor))) and float(jnp.abs(warm.attractor).max()) > 0
+    carried, handed = simulate_with_state(PAIR, lub, surf, _op(3475.0), fid, warm)
+    cold = jg.simulate(PAIR, lub, surf, _op(3475.0), fid)
+    assert int(carried.status) == int(cold.status) == STATUS_ATTRACTOR
+    assert float(handed.on_attractor) == 1.0
+    # bounds: the spread of 256-cycle means over windows of one non-periodic attractor (measured
+    # ±1 % for Φ̄ at 1950, 3450 and 3900 rpm, about twice that for the DTE RMS), not the
+    # 10-30 % by which the attractor moves Φ̄ from the unstable orbit's
+    assert float(carried.power_loss) == pytest.approx(float(cold.power_loss), rel=0.015)
+    assert float(carried.dte_rms) == pytest.approx(float(cold.dte_rms), rel=0.03)
 
 
 @pytest.mark.slow
@@ -181,7 +217,7 @@ def test_ehl_rung_attractor_means_follow_exact_ehl_solves_slow():
     rec = record_attractor(
         dyn, mesh, warm.orbit, options, fid.settle_periods, fid.attractor_periods, DEFAULT_KICK
     )
-    # the record the result was averaged over (all 64 cycles: stride 1)
+    # the record the result was averaged over (every recorded cycle)
     assert np.asarray(rec.tooth_force).mean(0) == pytest.approx(np.asarray(res.tooth_force))
 
     def exact(wu):

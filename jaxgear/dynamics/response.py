@@ -492,22 +492,24 @@ def _regauge(z):
 DEFAULT_KICK = 1e-3
 
 
-def _rk4(dyn: GearDynamics, z, s, n_steps, h=None, t0=0.0):
-    """``n_steps`` classical Runge-Kutta steps of size ``h`` (default ``dyn.step``) from τ = ``t0``
-    (mesh periods). Used for the attractor, whose settling is a transient whose details do not
-    matter: about 3.5× cheaper per step on a CPU than a diffrax solve per period (measured,
-    2026-11-24), and cheap to compile (the shooting's diffrax solve is not traced again)."""
-    h = dyn.step if h is None else h
+def _rk4_step(dyn: GearDynamics, z, s, t, h):
+    """One classical Runge-Kutta step of size ``h`` from τ = ``t`` (mesh periods)."""
+    k1 = dyn(t, z, s)
+    k2 = dyn(t + 0.5 * h, z + 0.5 * h * k1, s)
+    k3 = dyn(t + 0.5 * h, z + 0.5 * h * k2, s)
+    k4 = dyn(t + h, z + h * k3, s)
+    return z + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
-    def step(i, z):
-        t = t0 + i * h
-        k1 = dyn(t, z, s)
-        k2 = dyn(t + 0.5 * h, z + 0.5 * h * k1, s)
-        k3 = dyn(t + 0.5 * h, z + 0.5 * h * k2, s)
-        k4 = dyn(t + h, z + h * k3, s)
-        return z + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
-    return jax.lax.fori_loop(0, n_steps, step, z)
+def _rk4(dyn: GearDynamics, z, s, n_steps):
+    """``n_steps`` RK4 steps of ``dyn.step`` from τ = 0 (a whole number of mesh periods when
+    n_steps is a multiple of the steps per period). Used for the attractor, whose settling is a
+    transient whose details do not matter: about 3.5× cheaper per step on a CPU than a diffrax
+    solve per period (measured, 2026-11-24), and cheap to compile (the shooting's diffrax solve is
+    not traced again)."""
+    return jax.lax.fori_loop(
+        0, n_steps, lambda i, z: _rk4_step(dyn, z, s, i * dyn.step, dyn.step), z
+    )
 
 
 #: Mesh cycles per block of the settling: the load-torque correction is re-balanced after each.
@@ -542,17 +544,18 @@ def _settle(dyn: GearDynamics, z, s, options: DynamicsOptions, settle: int):
         lhs = a1 * dv[0] + a2 * dv[3] + c1 * dq[0] + c2 * dq[3]
         return (_regauge(z1), s + lhs / impulse), None
 
-    n_blocks = -(-settle // SETTLE_BLOCK)
-    (z, s), _ = jax.lax.scan(block, (z, s), None, length=n_blocks)
-    return z, s
+    n_blocks = (settle + SETTLE_BLOCK - 1) // SETTLE_BLOCK  # may be traced
+    return jax.lax.fori_loop(0, n_blocks, lambda _, carry: block(carry, None)[0], (z, s))
 
 
 def record_attractor(
     dyn: GearDynamics, mesh, w, options: DynamicsOptions, settle: int, record: int, kick: float
 ) -> AttractorRecord:
     """``AttractorRecord`` of ``dyn`` from the shooting unknowns ``w`` [13] (state and load-torque
-    correction s, held fixed), perturbed by ``kick`` times the largest displacement (gear 1's
-    coordinates up, gear 2's down) so that an unstable orbit is left. ``settle`` and ``record`` are static."""
+    correction s), perturbed by ``kick`` times the largest displacement (gear 1's coordinates up,
+    gear 2's down) so that an unstable orbit is left. ``record`` is static; ``settle`` (cycles,
+    rounded up to blocks of SETTLE_BLOCK) and ``kick`` may be traced (a start already on the
+    attractor, at a neighbouring speed, needs no kick and a short settling)."""
     m = mesh.n_positions
     z0, s = w[:12], w[12]
     # gear 1 forward, gear 2 back: a change of εd (a uniform shift would move the gears together
@@ -561,21 +564,35 @@ def record_attractor(
     z0 = z0 + kick * (jnp.max(jnp.abs(z0[:6])) + 1.0) * pattern
 
     z, s = _settle(dyn, z0, s, options, settle)
-    # whole RK4 steps between the mesh positions, no longer than the shooting's step
+    # whole RK4 steps between the mesh positions, no longer than the shooting's step; one flat loop
+    # over the record's steps (nested loops per cycle and position cost 5× more per step on a CPU)
     per = jnp.ceil(jnp.round(1.0 / dyn.step) / m).astype(jnp.int32)
     h = 1.0 / (m * per)
+    n_cycle = m * per
 
-    def cycle(z, _):
-        def position(z, i):
-            return _rk4(dyn, z, s, per, h, t0=i / m), z
+    rows = record * m
+    scratch = rows  # where the steps inside a position's interval write (an unconditional update
+    # at a computed row stays in place; a masked one copied the whole buffer every step)
 
-        z_end, zs = jax.lax.scan(position, z, jnp.arange(m))
-        return _regauge(z_end), (zs, 0.5 * (z_end[0] + z_end[3]))
+    def step(i, carry):
+        z, zs, drift = carry
+        z = _rk4_step(dyn, z, s, (i % n_cycle) * h, h)
+        end = i % n_cycle == n_cycle - 1
+        drift = drift + jnp.where(end, 0.5 * (z[0] + z[3]), 0.0)
+        z = jnp.where(end, _regauge(z), z)
+        k = (i + 1) // per  # the mesh position this step ends at
+        row = jnp.where(((i + 1) % per == 0) & (k < rows), k, scratch)
+        return z, jax.lax.dynamic_update_index_in_dim(zs, z, row, 0), drift
 
-    z_end, (zs, drift) = jax.lax.scan(cycle, z, None, length=record)  # [K, M, 12], [K]
+    zs0 = jnp.zeros((rows + 1, z.shape[0]), dtype=z.dtype).at[0].set(z)
+    z_end, zs, drift = jax.lax.fori_loop(
+        0, record * n_cycle, step, (z, zs0, jnp.zeros((), dtype=z.dtype))
+    )
+    zs = zs[:rows]
+    zs = zs.reshape(record, m, -1)  # [K, M, 12]
     # mean rigid speed over the record relative to the nominal pitch-line speed rb1 Ω1
     nominal = dyn.base_radius[0] * dyn.omega[0] * dyn.mesh_period / LENGTH_SCALE  # per cycle
-    speed_error = jnp.sum(drift) / (record * nominal)
+    speed_error = drift / (record * nominal)
     _, _, dte, d, fm, tooth, surf = _kinematics(dyn, mesh, zs)
     flat = dte.reshape(-1)
     harm = 2.0 * _safe_abs_complex(jnp.fft.rfft(flat) / flat.shape[0])
