@@ -8,6 +8,7 @@ use what the attractor did not produce: the periodic orbit where it is stable, a
 balance, which fixes the long-time mean mesh force at T1/rb1 in a frictionless mesh.
 """
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -15,12 +16,20 @@ import pytest
 
 import jaxgear as jg
 from jaxgear.dynamics import DynamicsOptions, attractor_response, dynamic_response
-from jaxgear.tribodynamics import STATUS_ATTRACTOR, STATUS_DYNAMICS, STATUS_NAMES
+from jaxgear.tribodynamics import (
+    STATUS_ATTRACTOR,
+    STATUS_DYNAMICS,
+    STATUS_NAMES,
+    cold_start,
+    simulate_with_state,
+)
 
 PAIR = jg.presets.li2015_pair_calibrated()
 OPTS = DynamicsOptions(n_positions=32)
 MESH = jg.mesh_cycle(PAIR, torque=700.0, n_positions=32)
 T1_OVER_RB1 = float(MESH.total_load)
+# one point of a continuation sweep (what jg.sweep scans), compiled once for cold and warm starts
+_STEP = eqx.filter_jit(simulate_with_state)
 
 
 def _op(rpm):
@@ -101,10 +110,8 @@ def test_chaotic_rattle_keeps_the_moment_balance_over_the_record():
 @pytest.fixture(scope="module")
 def at_3450():
     """The coupled model at 3450 rpm (default fidelity): result and WarmStart."""
-    from jaxgear.tribodynamics import simulate_with_state
-
-    lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
-    return simulate_with_state(PAIR, lub, surf, _op(3450.0), jg.Fidelity())
+    lub, surf, fid = jg.presets.mil_l_23699(), jg.presets.ground(), jg.Fidelity()
+    return _STEP(PAIR, lub, surf, _op(3450.0), fid, cold_start(fid.n_positions))
 
 
 def test_simulate_reports_means_over_the_attractor_where_no_orbit_is_stable(at_3450):
@@ -129,15 +136,15 @@ def test_a_continuation_sweep_carries_the_attractor_to_the_next_speed(at_3450):
     windows of one attractor (measured at 3475 and 3500 rpm: Φ̄ +0.7 %, +0.4 %; DTE RMS −1.8 %,
     −2.2 %).
     """
-    from jaxgear.tribodynamics import ATTRACTOR_WARM_SETTLE, simulate_with_state
+    from jaxgear.tribodynamics import ATTRACTOR_WARM_SETTLE
 
     lub, surf, fid = jg.presets.mil_l_23699(), jg.presets.ground(), jg.Fidelity()
     assert ATTRACTOR_WARM_SETTLE < fid.settle_periods
     first, warm = at_3450
     assert int(first.status) == STATUS_ATTRACTOR and float(warm.on_attractor) == 1.0
     assert bool(jnp.all(jnp.isfinite(warm.attractor))) and float(jnp.abs(warm.attractor).max()) > 0
-    carried, handed = simulate_with_state(PAIR, lub, surf, _op(3475.0), fid, warm)
-    cold = jg.simulate(PAIR, lub, surf, _op(3475.0), fid)
+    carried, handed = _STEP(PAIR, lub, surf, _op(3475.0), fid, warm)
+    cold, _ = _STEP(PAIR, lub, surf, _op(3475.0), fid, cold_start(fid.n_positions))
     assert int(carried.status) == int(cold.status) == STATUS_ATTRACTOR
     assert float(handed.on_attractor) == 1.0
     # bounds: the spread of 256-cycle means over windows of one non-periodic attractor (measured
