@@ -100,7 +100,8 @@ class Fidelity(eqx.Module):
             settle on another attractor (a period-doubled orbit, a torus, a chaotic rattle): the
             result is then the mean over this many mesh cycles of that attractor, reached by time
             integration with the last interface tables (``jaxgear.dynamics.attractor_response``),
-            with the contacts evaluated at every position of every recorded cycle (status 6,
+            with the contacts evaluated at every position of 64 cycles spread over the record
+            (tribodynamics.ATTRACTOR_CONTACT_CYCLES; status 6,
             "attractor"; on the EHL rungs through the closed-form mixed EHL contact scaled to the
             rung's level on the orbit: see ``tribodynamics._attractor_means``).
             0: report the unstable periodic orbit, flagged (status 2), as before. Default 256:

@@ -44,6 +44,10 @@ STATUS_CONTACT = 3  # a contact solve did not converge
 STATUS_NON_FINITE = 4
 # 5 is the sweep's own "chunk raised or non-finite" (sweep.SweepResult)
 STATUS_ATTRACTOR = 6  # no stable periodic orbit: means over the attractor reached in time
+# Recorded attractor cycles at which the contacts are evaluated (of Fidelity.attractor_periods):
+# the closed-form mixed EHL contacts of a cycle cost ~4 ms on 2 cores (64 contacts), the record's
+# dynamics ~0.9 ms a cycle, so 64 of 256 cycles keep the contacts at about the dynamics' cost.
+ATTRACTOR_CONTACT_CYCLES = 64
 # Settling cycles of an attractor continued from the previous speed's (continuation sweeps): the
 # attractor moves little between neighbouring speeds (measured: see tests/test_attractor.py).
 ATTRACTOR_WARM_SETTLE = 200
@@ -563,11 +567,11 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     The dynamics run in time with the last interface tables (the cycle's friction and damping; a
     table per mesh phase, so the friction does not follow each cycle's load within the
     integration), from the unstable orbit slightly perturbed, through ``settle_periods`` cycles;
-    then the contacts are evaluated at every recorded position of every cycle: exactly on the
-    closed-form rungs (~80 µs a cycle); on the EHL rungs by the closed-form mixed EHL contact
-    scaled to the rung's level on the orbit (below), not by new EHL solves. Returned per position:
-    the means over the record of the contact outputs (so Φ̄ is the record's mean loss), tooth forces and velocities, and the DTE's mean over the whole
-    record (its mesh harmonics are the record's). Status 6 (STATUS_ATTRACTOR), or the status kept
+    then the contacts are evaluated at every recorded position of ATTRACTOR_CONTACT_CYCLES cycles
+    spread over the record: exactly on the closed-form rungs; on the EHL rungs by the closed-form
+    mixed EHL contact scaled to the rung's level on the orbit (below), not by new EHL solves.
+    Returned per position: the means over those cycles of the contact outputs (so Φ̄ is the
+    record's mean loss), tooth forces and velocities, and the DTE's mean over the whole record (its mesh harmonics are the record's). Status 6 (STATUS_ATTRACTOR), or the status kept
     where the record is not finite. No derivative passes through the attractor (its means are not
     smooth functions of the design).
 
@@ -658,8 +662,14 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         else:
             each = contacts_at
 
-        # every recorded cycle (closed forms on every rung: ~80 µs a cycle)
-        loads, speeds = rec.tooth_force, rec.surface_velocity
+        # ATTRACTOR_CONTACT_CYCLES cycles spread over the whole record (the window's length, not
+        # the sample count, sets the bias of the mean), one from every block of `stride`, at a
+        # position in the block that cycles through 0..stride−1 so that a period-2, -3 or -4
+        # attractor is not sampled at one of its phases only
+        stride = max(1, fidelity.attractor_periods // ATTRACTOR_CONTACT_CYCLES)
+        k = jnp.arange(fidelity.attractor_periods // stride)
+        pick = k * stride + k % stride
+        loads, speeds = rec.tooth_force[pick], rec.surface_velocity[pick]
         per_cycle = jax.vmap(each)(loads, speeds)
         mean = eqx.tree_at(
             lambda f: (f.converged, f.failed),

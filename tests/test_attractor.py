@@ -224,7 +224,7 @@ def test_ehl_rung_attractor_means_follow_exact_ehl_solves_slow():
     rec = record_attractor(
         dyn, mesh, warm.orbit, options, fid.settle_periods, fid.attractor_periods, DEFAULT_KICK
     )
-    # the record the result was averaged over (every recorded cycle)
+    # the record the result was averaged over (all 64 cycles: stride 1)
     assert np.asarray(rec.tooth_force).mean(0) == pytest.approx(np.asarray(res.tooth_force))
 
     def exact(wu):
