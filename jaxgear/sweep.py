@@ -175,9 +175,20 @@ def _step(warm, point, shared):
     pair, lubricant, surfaces, op, fidelity = shared
     p, s, o = _apply(pair, surfaces, op, point)
     result, new_warm = simulate_with_state(p, lubricant, s, o, fidelity, warm)
-    # A failed point must not poison the rest of the march: keep the last good state.
+    # A failed point must not poison the rest of the march: keep the last good state. A point on an
+    # attractor (status 6, not converged) hands on its attractor only, so that the next speed
+    # without a stable orbit continues from it; a converged point clears it (its flag is 0).
     good = result.converged
     carry = jax.tree_util.tree_map(lambda a, b: jnp.where(good, a, b), new_warm, warm)
+    on_attractor = result.status == STATUS_ATTRACTOR
+    carry = eqx.tree_at(
+        lambda w: (w.attractor, w.on_attractor),
+        carry,
+        (
+            jnp.where(on_attractor, new_warm.attractor, carry.attractor),
+            jnp.where(on_attractor, new_warm.on_attractor, carry.on_attractor),
+        ),
+    )
     return carry, _outputs(result)
 
 

@@ -130,11 +130,10 @@ def test_a_continuation_sweep_carries_the_attractor_to_the_next_speed(at_3450):
     """The paper's stepwise speed increase: a point with no stable orbit hands the end of its
     record to the next (``WarmStart.attractor``), which settles from it for ATTRACTOR_WARM_SETTLE
     cycles instead of ``settle_periods`` from a kicked orbit. Checked against what it did not
-    produce: the same speed settled cold. Where the attractor is periodic (a rattle locked to the
-    mesh: 3375-3550 rpm at ``Fidelity.fast()``) both starts reach the same record, measured 0.0 %
-    apart; at the default fidelity it is not periodic there, and the two records are different
-    windows of one attractor (measured at 3475 and 3500 rpm: Φ̄ +0.7 %, +0.4 %; DTE RMS −1.8 %,
-    −2.2 %).
+    produce: the same speed settled cold; at the default fidelity the 3475 rpm attractor is not
+    periodic, so the two records are different windows of one attractor (measured: Φ̄ −0.2 %,
+    DTE RMS −1.8 %). And ``jg.sweep(mode="continuation")`` does hand it on: its second point is
+    the warm-started one, not the cold one.
     """
     from jaxgear.tribodynamics import ATTRACTOR_WARM_SETTLE
 
@@ -152,6 +151,14 @@ def test_a_continuation_sweep_carries_the_attractor_to_the_next_speed(at_3450):
     # 10-30 % by which the attractor moves Φ̄ from the unstable orbit's
     assert float(carried.power_loss) == pytest.approx(float(cold.power_loss), rel=0.015)
     assert float(carried.dte_rms) == pytest.approx(float(cold.dte_rms), rel=0.03)
+    swept = jg.sweep(
+        PAIR, lub, surf, _op(3450.0), speeds_rpm=[3450.0, 3475.0], fidelity=fid, mode="continuation"
+    )
+    assert [int(v) for v in swept.status] == [STATUS_ATTRACTOR, STATUS_ATTRACTOR]
+    # the same compiled physics in a scan: equal to rounding where the handover took place
+    assert float(swept.power_loss[0]) == pytest.approx(float(first.power_loss), rel=1e-9)
+    assert float(swept.power_loss[1]) == pytest.approx(float(carried.power_loss), rel=1e-9)
+    assert float(swept.dte_rms[1]) == pytest.approx(float(carried.dte_rms), rel=1e-9)
 
 
 @pytest.mark.slow
