@@ -586,12 +586,15 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     from .dynamics.model import build_dynamics
     from .dynamics.response import DEFAULT_KICK, record_attractor
 
-    options = _dynamics_options(fidelity)
     keys = ("forces", "load", "velocity", "dte", "interface", "guess")
     operand = (pair, lubricant, surfaces, op, mesh, {k: state[k] for k in keys}, status, warm)
 
     def on_attractor(operand):
         pair, lubricant, surfaces, op, mesh, st, status, warm = jax.lax.stop_gradient(operand)
+        # built here, not closed over: its array fields are created in the trace they are used
+        # in (closed over from the simulate trace they leaked when the JVP rule of the lazy cond
+        # re-traced this branch: jax.jacfwd of simulate failed with "No constant handler")
+        options = _dynamics_options(fidelity)
         load, velocity = st["load"], st["velocity"]
         dyn = build_dynamics(pair, op, mesh, st["interface"], options)
         continued = warm[1] > 0.5

@@ -251,3 +251,23 @@ def test_ehl_rung_attractor_means_follow_exact_ehl_solves_slow():
     assert float(res.power_loss_sliding) == pytest.approx(sliding, rel=0.06)
     assert float(res.power_loss_rolling) == pytest.approx(rolling, rel=0.05)
     assert float(res.power_loss) == pytest.approx(sliding + rolling, rel=0.05)
+
+
+def test_forward_mode_gradient_lowers_with_the_attractor_branch():
+    # Regression: the attractor branch closed over DynamicsOptions arrays made in the simulate
+    # trace; the JVP rule of the lazy cond re-traces the branch, so jax.jacfwd of simulate (what
+    # optimise_tip_relief uses) failed to lower with "No constant handler for type
+    # DynamicJaxprTracer" at every tribo-dynamic fidelity with attractor_periods > 0. Lowering
+    # alone (no XLA compilation) is what failed; the values are checked against central
+    # differences by the slow gradient tests of tests/test_tribodynamics.py.
+    lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
+    fid = jg.Fidelity(friction="constant", constant_mu=0.05, backlash="smooth", n_positions=24)
+    assert fid.attractor_periods > 0
+
+    def eff(x):
+        pair = jg.presets.li2015_pair_calibrated(tip_relief=x[0])
+        op = jg.OperatingPoint(torque=x[1], speed_rpm=2500.0, inlet_temperature=363.15)
+        return jg.simulate(pair, lub, surf, op, fid).efficiency
+
+    lowered = jax.jit(jax.jacfwd(eff)).lower(jnp.asarray([10e-6, 700.0]))
+    assert "while" in lowered.as_text()  # the fixed point and the attractor's loops are there
