@@ -16,12 +16,13 @@ Targets (issue 6, this 2-core CPU): ``jaxgear run`` ≤ 90 s including compilati
 paper fidelity ≤ 2 min; a gradient ≤ 4× the forward cost.
 
 Writes the section ``end_to_end`` of benchmarks/RESULTS.md. Run (repository root), ~1 h:
-    python benchmarks/end_to_end.py [--skip-paper-sweep] [--skip-paper-gradient]
+    python benchmarks/end_to_end.py [--skip-paper-sweep] [--skip-paper-gradient] [--rows FILE]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -140,21 +141,38 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--skip-paper-sweep", action="store_true", help="no 149-speed paper() sweep")
     ap.add_argument("--skip-paper-gradient", action="store_true", help="no paper() gradient")
+    ap.add_argument(
+        "--rows",
+        type=Path,
+        help="JSON file of measured rows: rows found there are reused, new ones added as they are "
+        "measured (so a run that stops part way resumes; every row still comes from this script)",
+    )
     args = ap.parse_args(argv)
+    saved = json.loads(args.rows.read_text()) if args.rows and args.rows.exists() else {}
 
-    cold = _jaxgear_run("off")
-    with tempfile.TemporaryDirectory() as cache:
-        filling = _jaxgear_run(cache)
-        cached = _jaxgear_run(cache)
-    print("jaxgear run", f"{cold:.1f}", f"{filling:.1f}", f"{cached:.1f}", flush=True)
+    def row(key, measure):
+        if key not in saved:
+            saved[key] = measure()
+            if args.rows:
+                args.rows.write_text(json.dumps(saved, indent=1))
+        return saved[key]
 
-    sweeps = [_sweep_row("fast()", jg.Fidelity.fast())]
+    def runs():
+        cold = _jaxgear_run("off")
+        with tempfile.TemporaryDirectory() as cache:
+            filling = _jaxgear_run(cache)
+            cached = _jaxgear_run(cache)
+        print("jaxgear run", f"{cold:.1f}", f"{filling:.1f}", f"{cached:.1f}", flush=True)
+        return [cold, filling, cached]
+
+    cold, filling, cached = row("jaxgear_run", runs)
+    sweeps = [row("sweep fast()", lambda: _sweep_row("fast()", jg.Fidelity.fast()))]
     if not args.skip_paper_sweep:
-        sweeps.append(_sweep_row("paper()", jg.Fidelity.paper()))
-    one = _one_speed_rows(jg.Fidelity.paper())
-    grads = [_gradient_row("fast()", jg.Fidelity.fast())]
+        sweeps.append(row("sweep paper()", lambda: _sweep_row("paper()", jg.Fidelity.paper())))
+    one = row("one speed paper()", lambda: _one_speed_rows(jg.Fidelity.paper()))
+    grads = [row("gradient fast()", lambda: _gradient_row("fast()", jg.Fidelity.fast()))]
     if not args.skip_paper_gradient:
-        grads.append(_gradient_row("paper()", jg.Fidelity.paper()))
+        grads.append(row("gradient paper()", lambda: _gradient_row("paper()", jg.Fidelity.paper())))
 
     body = "\n".join(
         [
