@@ -4,8 +4,9 @@ REFERENCE §1 (paper): the dynamics, given the mesh interface tables (EHL dampin
 F1, F2 per position and tooth pair), give the dynamic tooth forces W_T and surface velocities uj; the
 contacts, given W_T and uj, give new tables; the two are iterated to a fixed point. jaxgear solves the
 fixed point with optimistix (damped fixed-point iteration) and differentiates the converged solution
-implicitly (``optx.ImplicitAdjoint`` with a matrix-free GMRES solve of (I − ∂T/∂x)), so gradients never
-pass through the iterations. The dynamic periodic orbit is carried in the fixed-point state, so each
+implicitly (``optx.ImplicitAdjoint`` with a matrix-free GMRES solve of (I − ∂T/∂x) that stops at the
+Krylov step where it has converged, ``_krylov.EarlyExitGMRES``), so gradients never pass through the
+iterations. The dynamic periodic orbit is carried in the fixed-point state, so each
 iteration's shooting starts from the previous orbit.
 
 The quasi-static variant (``Fidelity(dynamics="quasi_static")``) uses W_T = W_sT and the kinematic surface
@@ -17,10 +18,10 @@ from __future__ import annotations
 import equinox as eqx
 import jax
 import jax.numpy as jnp
-import lineax as lx
 import optimistix as optx
 from jaxtyping import Array, Bool, Float, Int
 
+from ._krylov import EarlyExitGMRES
 from ._validation import check_instance, check_non_negative, is_concrete
 from .anderson import Anderson
 from .dynamics.model import DynamicsOptions, MeshInterface
@@ -512,7 +513,11 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             atol=fidelity.fixed_point_rtol * 1e-3,
             norm=optx.max_norm,
         )
-    adjoint = optx.ImplicitAdjoint(linear_solver=lx.GMRES(rtol=1e-10, atol=1e-10, restart=20))
+    # One JVP of ``step`` per Krylov vector and direction. T contracts strongly where the fixed point
+    # converges in a few iterations, and then a few vectors solve the system (5 at 2500 rpm, fast());
+    # lineax's GMRES(20) spent two whole cycles (41 JVPs) there: the gradient cost 6.4× the forward
+    # instead of 3.0× (benchmarks/RESULTS.md, end_to_end).
+    adjoint = optx.ImplicitAdjoint(linear_solver=EarlyExitGMRES(rtol=1e-10, atol=0.0))
     sol = optx.fixed_point(
         step,
         solver,

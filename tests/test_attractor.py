@@ -253,21 +253,39 @@ def test_ehl_rung_attractor_means_follow_exact_ehl_solves_slow():
     assert float(res.power_loss) == pytest.approx(sliding + rolling, rel=0.05)
 
 
-def test_forward_mode_gradient_lowers_with_the_attractor_branch():
+def test_forward_mode_gradient_with_the_attractor_branch_matches_central_differences():
     # Regression: the attractor branch closed over DynamicsOptions arrays made in the simulate
     # trace; the JVP rule of the lazy cond re-traces the branch, so jax.jacfwd of simulate (what
     # optimise_tip_relief uses) failed to lower with "No constant handler for type
-    # DynamicJaxprTracer" at every tribo-dynamic fidelity with attractor_periods > 0. Lowering
-    # alone (no XLA compilation) is what failed; the values are checked against central
-    # differences by the slow gradient tests of tests/test_tribodynamics.py.
+    # DynamicJaxprTracer" at every tribo-dynamic fidelity with attractor_periods > 0.
+    # Compiled and run, it also checks the implicit derivative of the fixed point (solved by
+    # _krylov.EarlyExitGMRES) against central differences in the default test run; the slow tests
+    # of tests/test_tribodynamics.py do so at the EHL rungs.
     lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
-    fid = jg.Fidelity(friction="constant", constant_mu=0.05, backlash="smooth", n_positions=24)
+    fid = jg.Fidelity(
+        friction="constant",
+        constant_mu=0.05,
+        backlash="smooth",
+        n_positions=24,
+        fixed_point_tolerance=1e-10,
+    )
     assert fid.attractor_periods > 0
 
+    @jax.jit
     def eff(x):
         pair = jg.presets.li2015_pair_calibrated(tip_relief=x[0])
         op = jg.OperatingPoint(torque=x[1], speed_rpm=2500.0, inlet_temperature=363.15)
         return jg.simulate(pair, lub, surf, op, fid).efficiency
 
-    lowered = jax.jit(jax.jacfwd(eff)).lower(jnp.asarray([10e-6, 700.0]))
-    assert "while" in lowered.as_text()  # the fixed point and the attractor's loops are there
+    x0 = jnp.asarray([10e-6, 700.0])
+    g = jax.jit(jax.jacfwd(eff))(x0)
+    steps = (1e-8, 0.5)  # 1e-3 and 7e-4 of the values
+    fd = [
+        (eff(x0.at[i].add(h)) - eff(x0.at[i].add(-h))) / (2.0 * h) for i, h in enumerate(steps)
+    ]
+    # central differences in float64 with the fixed point converged to 1e-10 and the orbit's
+    # Newton to 1e-9: truncation O(h²) and noise 1e-10/h leave ~1e-5 relative; 1e-3 as the slow
+    # gradient tests (a wrong tangent, e.g. an unconverged implicit solve, is off by far more)
+    assert np.all(np.isfinite(np.asarray(g)))
+    assert float(g[0]) == pytest.approx(float(fd[0]), rel=1e-3)
+    assert float(g[1]) == pytest.approx(float(fd[1]), rel=1e-3)

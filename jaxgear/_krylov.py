@@ -1,0 +1,180 @@
+"""GMRES that stops as soon as it has converged, for the implicit derivative of the fixed point.
+
+The tribo-dynamic fixed point is differentiated implicitly (``optx.ImplicitAdjoint``): each
+direction costs a solve of (I − ∂T/∂x) v = ∂T/∂θ·dθ, one JVP of the fixed-point map T per Krylov
+vector. ``lineax.GMRES`` checks convergence only between restart cycles and ends only when two
+cycles agree, so it costs at least two full cycles (41 JVPs at restart 20) even where T contracts so
+strongly that a handful of Krylov vectors solve the system: 85 % of the gradient's cost at
+``Fidelity.fast()`` (benchmarks/RESULTS.md, end_to_end). This GMRES tracks the residual of its
+least-squares problem at every Arnoldi step (Givens rotations) and stops there; each cycle ends with
+the true residual b − A x, so a cycle cannot report convergence that rounding has faked.
+
+The unknowns are a pytree whose leaves carry different units (N, m/s, m, scaled orbit states). The
+solve runs in variables scaled per leaf by the magnitude of the root (the point the operator is
+linearised at) — a similarity transform, which changes neither the solution nor the spectrum — so
+the residual norm weighs every leaf by its own size, not by its unit.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import lineax as lx
+from jax.flatten_util import ravel_pytree
+
+
+def _leaf_scales(x) -> Any:
+    """Per-leaf magnitude of ``x`` (max |leaf|; 1 where a leaf is zero, non-finite or not inexact)."""
+
+    def one(leaf):
+        leaf = jnp.asarray(leaf)
+        if not jnp.issubdtype(leaf.dtype, jnp.inexact) or leaf.size == 0:
+            return jnp.ones((), dtype=float)
+        m = jnp.max(jnp.abs(leaf))
+        return jnp.where(jnp.isfinite(m) & (m > 0), m, 1.0)
+
+    return jax.tree_util.tree_map(one, x)
+
+
+def _givens(a, b):
+    """(c, s) with [c s; −s c]·[a, b] = [r, 0]."""
+    r = jnp.hypot(a, b)
+    safe = jnp.where(r > 0, r, 1.0)
+    return jnp.where(r > 0, a / safe, 1.0), jnp.where(r > 0, b / safe, 0.0)
+
+
+class EarlyExitGMRES(lx.AbstractLinearSolver):
+    """Restarted GMRES(m) with a convergence test at every Arnoldi step, in per-leaf scaled variables.
+
+    Converged when ‖b̂ − Â x̂‖₂ ≤ rtol ‖b̂‖₂ + atol (hats: scaled by the root's per-leaf magnitudes;
+    the true residual, checked at the end of each cycle). Not converged after ``max_restarts``
+    cycles: ``RESULTS.max_steps_reached`` (lineax then raises, or reports it with ``throw=False``).
+
+    Args:
+        rtol, atol: tolerances on the scaled residual (see above).
+        restart: Krylov vectors per cycle (the basis is stored: restart + 1 vectors).
+        max_restarts: cycles before giving up.
+    """
+
+    rtol: float
+    atol: float
+    restart: int = eqx.field(static=True, default=30)
+    max_restarts: int = eqx.field(static=True, default=20)
+
+    def init(self, operator, options):
+        del options
+        if not eqx.tree_equal(operator.in_structure(), operator.out_structure()):
+            raise ValueError("EarlyExitGMRES needs a square operator (in and out structures equal)")
+        x = getattr(operator, "x", None)
+        if x is None:
+            scales = jax.tree_util.tree_map(
+                lambda s: jnp.ones((), dtype=s.dtype), operator.in_structure()
+            )
+        else:
+            scales = _leaf_scales(x)
+        return lx.linearise(operator), scales
+
+    def compute(self, state, vector, options):
+        del options
+        operator, scales = state
+        flat_b, unravel = ravel_pytree(vector)
+        flat_d, _ = ravel_pytree(
+            jax.tree_util.tree_map(
+                lambda v, s: jnp.broadcast_to(s, jnp.shape(v)).astype(v.dtype), vector, scales
+            )
+        )
+        dtype = flat_b.dtype
+
+        def mv(v):
+            return ravel_pytree(operator.mv(unravel(flat_d * v)))[0] / flat_d
+
+        b = flat_b / flat_d
+        n, m = b.shape[0], min(self.restart, b.shape[0])
+        tol = self.rtol * jnp.linalg.norm(b) + self.atol
+
+        def cycle(x0):
+            r0 = b - mv(x0)
+            beta = jnp.linalg.norm(r0)
+            basis = jnp.zeros((m + 1, n), dtype).at[0].set(r0 / jnp.where(beta > 0, beta, 1.0))
+            hess = jnp.zeros((m + 1, m), dtype)
+            cs, sn = jnp.ones(m, dtype), jnp.zeros(m, dtype)
+            g = jnp.zeros(m + 1, dtype).at[0].set(beta)
+
+            def cond(c):
+                k, _, _, _, _, g, stop = c
+                return (k < m) & (jnp.abs(g[k]) > tol) & ~stop
+
+            def body(c):
+                k, basis, hess, cs, sn, g, _ = c
+                w = mv(basis[k])
+                live = (jnp.arange(m + 1) <= k).astype(dtype)
+                # classical Gram-Schmidt, twice (as stable as modified Gram-Schmidt, vectorised)
+                h = (basis @ w) * live
+                w = w - h @ basis
+                h2 = (basis @ w) * live
+                w = w - h2 @ basis
+                h = h + h2
+                hn = jnp.linalg.norm(w)
+                happy = hn <= 1e-14 * jnp.maximum(beta, 1e-300)  # Krylov space exhausted: exact
+                basis = basis.at[k + 1].set(jnp.where(happy, 0.0, w / jnp.where(happy, 1.0, hn)))
+                h = h.at[k + 1].set(hn)
+
+                # the earlier rotations, then a new one that zeroes h[k+1]
+                def rotate(i, h):
+                    hi, hj = h[i], h[i + 1]
+                    act = i < k
+                    return h.at[i].set(jnp.where(act, cs[i] * hi + sn[i] * hj, hi)).at[i + 1].set(
+                        jnp.where(act, -sn[i] * hi + cs[i] * hj, hj)
+                    )
+
+                h = jax.lax.fori_loop(0, m, rotate, h)
+                c_k, s_k = _givens(h[k], h[k + 1])
+                h = h.at[k].set(c_k * h[k] + s_k * h[k + 1]).at[k + 1].set(0.0)
+                g = g.at[k + 1].set(-s_k * g[k]).at[k].set(c_k * g[k])
+                hess = hess.at[:, k].set(h)
+                return k + 1, basis, hess, cs.at[k].set(c_k), sn.at[k].set(s_k), g, happy
+
+            stop0 = beta <= tol
+            k, basis, hess, _, _, g, _ = jax.lax.while_loop(
+                cond, body, (jnp.asarray(0), basis, hess, cs, sn, g, stop0)
+            )
+            # upper-triangular solve on the k columns used (unused ones: identity, zero rhs)
+            used = jnp.arange(m) < k
+            r = hess[:m, :m]
+            r = jnp.where(used[:, None] & used[None, :], r, jnp.eye(m, dtype=dtype))
+            diag_ok = jnp.abs(jnp.diagonal(r)) > 0
+            r = jnp.where(jnp.eye(m, dtype=bool) & ~diag_ok[:, None], 1.0, r)
+            y = jax.scipy.linalg.solve_triangular(r, jnp.where(used, g[:m], 0.0), lower=False)
+            return x0 + y @ basis[:m], k
+
+        def outer_cond(c):
+            _, res, i, _ = c
+            return (res > tol) & (i < self.max_restarts)
+
+        def outer_body(c):
+            x, _, i, steps = c
+            x, k = cycle(x)
+            return x, jnp.linalg.norm(b - mv(x)), i + 1, steps + k
+
+        x, res, _, steps = jax.lax.while_loop(
+            outer_cond,
+            outer_body,
+            (jnp.zeros_like(b), jnp.linalg.norm(b), jnp.asarray(0), jnp.asarray(0)),
+        )
+        ok = res <= tol
+        result = lx.RESULTS.where(ok, lx.RESULTS.successful, lx.RESULTS.max_steps_reached)
+        return unravel(flat_d * x), result, {"num_steps": steps, "residual": res}
+
+    def transpose(self, state, options):
+        operator, scales = state
+        return (operator.transpose(), scales), options
+
+    def conj(self, state, options):
+        operator, scales = state
+        return (lx.conj(operator), scales), options
+
+    def assume_full_rank(self):
+        return True
