@@ -126,8 +126,11 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
                 def rotate(i, h):
                     hi, hj = h[i], h[i + 1]
                     act = i < k
-                    return h.at[i].set(jnp.where(act, cs[i] * hi + sn[i] * hj, hi)).at[i + 1].set(
-                        jnp.where(act, -sn[i] * hi + cs[i] * hj, hj)
+                    return (
+                        h.at[i]
+                        .set(jnp.where(act, cs[i] * hi + sn[i] * hj, hi))
+                        .at[i + 1]
+                        .set(jnp.where(act, -sn[i] * hi + cs[i] * hj, hj))
                     )
 
                 h = jax.lax.fori_loop(0, m, rotate, h)

@@ -280,9 +280,7 @@ def test_forward_mode_gradient_with_the_attractor_branch_matches_central_differe
     x0 = jnp.asarray([10e-6, 700.0])
     g = jax.jit(jax.jacfwd(eff))(x0)
     steps = (1e-8, 0.5)  # 1e-3 and 7e-4 of the values
-    fd = [
-        (eff(x0.at[i].add(h)) - eff(x0.at[i].add(-h))) / (2.0 * h) for i, h in enumerate(steps)
-    ]
+    fd = [(eff(x0.at[i].add(h)) - eff(x0.at[i].add(-h))) / (2.0 * h) for i, h in enumerate(steps)]
     # central differences in float64 with the fixed point converged to 1e-10 and the orbit's
     # Newton to 1e-9: truncation O(h²) and noise 1e-10/h leave ~1e-5 relative; 1e-3 as the slow
     # gradient tests (a wrong tangent, e.g. an unconverged implicit solve, is off by far more)

@@ -63,7 +63,9 @@ def test_matches_a_dense_solve_across_leaf_scales(rho):
     assert err < 1e-8
     # every leaf is solved to its own scale, the 1e-6 one (metres) as well as the 1e4 one (N)
     for sl in (slice(0, 64), slice(64, 77), slice(77, None)):
-        assert np.allclose(np.asarray(x)[sl], exact[sl], rtol=0, atol=1e-8 * np.max(np.abs(exact[sl])))
+        assert np.allclose(
+            np.asarray(x)[sl], exact[sl], rtol=0, atol=1e-8 * np.max(np.abs(exact[sl]))
+        )
 
 
 def test_stops_when_the_krylov_space_is_exhausted():
