@@ -1,0 +1,176 @@
+"""Why the tribo-dynamic loss falls below the quasi-static one at the resonances (REFERENCE §7 R3)
+and why 1500 N m raises Ψ (R7): the contact loss is concave in the tooth load.
+
+For a fixed contact law Φ_n = φ(W_n, u1, u2) per tooth pair, the dynamics changes the cycle-mean loss
+Φ̄ through the tooth loads W_T(t) and the surface velocities uj(t). The mean of W_T over a cycle is
+fixed by the moment balance (the mean mesh force is T1/rb1), so where φ is concave in W (φ ∝ W^k,
+k < 1) any load swing lowers Φ̄ (Jensen's inequality), and where it is convex, raises it. This script
+measures, on the ``ehl_formula`` rung of ``Fidelity.fast()`` (its closed-form contact law reproduces the
+paper fidelity's Φ̄ within 6.1 % over the baseline sweep):
+
+1. the load exponent k = d ln φ / d ln W of one contact at the pitch point, over speed and
+   slide-to-roll ratio;
+2. at every speed of the baseline sweep (every 100 rpm) with a stable periodic orbit (status 0), the
+   tribo-dynamic Φ̄ decomposed by re-evaluating the contact law on the converged tables:
+   Φ̄(W_T, u_TD) (= the result), Φ̄(W_sT, u_TD) (dynamic velocities, static loads), and Φ̄_lin, the
+   same contacts made linear in load at each position (φ(W_sT, u_TD) · W_T/W_sT: the friction
+   coefficient of the static load kept). The ratio Φ̄_lin/Φ̄(W_T, u_TD) is what the concavity costs.
+
+Writes the section ``load_convexity`` of benchmarks/RESULTS.md. Run (repository root), ~2 min:
+    python benchmarks/load_convexity.py
+"""
+
+from __future__ import annotations
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+import jax.numpy as jnp  # noqa: E402
+import numpy as np  # noqa: E402
+from _report import machine, write_section  # noqa: E402
+
+import jaxgear as jg  # noqa: E402
+from jaxgear.gear.mesh import mesh_cycle  # noqa: E402
+from jaxgear.lubrication.ehl_formula import ehl_formula_contact  # noqa: E402
+from jaxgear.material import reduced_modulus  # noqa: E402
+from jaxgear.tribodynamics import formula_ehl_contact_forces  # noqa: E402
+
+PAIR = jg.presets.li2015_pair_calibrated()
+LUB, SURF = jg.presets.mil_l_23699(), jg.presets.ground()
+FID = jg.Fidelity.fast()
+T_IN = 363.15
+
+
+def _op(rpm, torque=700.0):
+    return jg.OperatingPoint(torque=torque, speed_rpm=rpm, inlet_temperature=T_IN)
+
+
+def load_exponents():
+    """k = d ln φ/d ln w at the pitch point (R = 12.83 mm, 700 N m on one pair), by central
+    differences over w × (1 ± 1e-4), for the total and the sliding loss per unit width."""
+    e_red = float(reduced_modulus(*PAIR.materials))
+    w0 = 700.0 / float(jg.gear_geometry(PAIR).base_radius[0]) / float(PAIR.face_width)
+
+    def loss(w, u1, u2):
+        c = ehl_formula_contact(
+            12.826e-3,
+            w,
+            u1,
+            u2,
+            e_red,
+            LUB,
+            T_IN,
+            SURF.composite_rq,
+            boundary_friction=FID.boundary_friction,
+            shear=FID.shear,
+            density_product=FID.asperity_density_product,
+            slope_ratio=FID.asperity_slope_ratio,
+        )
+        return c.power_sliding + c.power_rolling, c.power_sliding, c.asperity_load / w
+
+    rows = []
+    for rpm in (500.0, 1750.0, 2500.0, 3500.0):
+        ur = 2.686e-3 * rpm
+        for srr in (0.05, 0.3, 0.6):
+            u1, u2 = ur * (1 + srr / 2), ur * (1 - srr / 2)
+            hi, lo, mid = loss(w0 * 1.0001, u1, u2), loss(w0 / 1.0001, u1, u2), loss(w0, u1, u2)
+            k = [float(jnp.log(a / b) / (2 * jnp.log(1.0001))) for a, b in zip(hi[:2], lo[:2])]
+            rows.append((rpm, srr, k[0], k[1], float(mid[2])))
+    return rows
+
+
+def decomposition(rpm):
+    """(status, Φ̄ result, Φ̄(W_T, u_TD), Φ̄(W_sT, u_TD), Φ̄_lin, Φ̄ quasi-static, load swing) at rpm."""
+    op = _op(rpm)
+    td = jg.simulate(PAIR, LUB, SURF, op, FID)
+    qs = jg.simulate(PAIR, LUB, SURF, op, FID.replace(dynamics="quasi_static"))
+    mesh = mesh_cycle(PAIR, op.torque, FID.n_positions, stiffness=FID.stiffness)
+    u_td = td.surface_velocity
+    static = mesh.normal_load
+
+    def cycle_loss(load, u):
+        f = formula_ehl_contact_forces(PAIR, LUB, SURF, mesh, FID, load, u[..., 0], u[..., 1], T_IN)
+        return f.power_sliding + f.power_rolling  # [M, 2]
+
+    phi_td = cycle_loss(td.tooth_force, u_td)
+    phi_static_load = cycle_loss(static, u_td)
+    ratio = jnp.where(static > 0, td.tooth_force / jnp.where(static > 0, static, 1.0), 0.0)
+    phi_lin = phi_static_load * ratio
+    mean = lambda x: float(jnp.mean(jnp.sum(x, axis=-1)))
+    total_static = jnp.sum(static, axis=-1)
+    swing = float(jnp.max(jnp.sum(td.tooth_force, axis=-1) / total_static))
+    return (
+        int(td.status),
+        float(td.power_loss),
+        mean(phi_td),
+        mean(phi_static_load),
+        mean(phi_lin),
+        float(qs.power_loss),
+        swing,
+    )
+
+
+def main():
+    exps = load_exponents()
+    for r in exps:
+        print("k", r, flush=True)
+    rows = []
+    for rpm in np.arange(500.0, 4200.0 + 1e-9, 100.0):
+        d = decomposition(float(rpm))
+        print(rpm, d, flush=True)
+        rows.append((float(rpm), *d))
+
+    lines = [
+        f"Machine: {machine()}. `Fidelity.fast()` (ehl_formula: Pan-Hamrock film, Greenwood-Tripp "
+        "asperity load, paper η* traction, Goksem-Hargreaves rolling), calibrated pair, ground, "
+        "700 N m, 90 °C.",
+        "",
+        "Load exponent k = d ln φ/d ln W of one contact at the pitch point (R = 12.83 mm, "
+        f"w = {700.0 / float(jg.gear_geometry(PAIR).base_radius[0]) / 0.02:.3g} N/m):",
+        "",
+        "| rpm | slide-to-roll | k total | k sliding | asperity share of the load |",
+        "|---|---|---|---|---|",
+    ]
+    lines += [f"| {a:.0f} | {b:.2f} | {c:.2f} | {d:.2f} | {e:.3f} |" for a, b, c, d, e in exps]
+    lines += [
+        "",
+        "Tribo-dynamic Φ̄ re-evaluated on the converged tables (status-0 speeds; the others are "
+        "means over an attractor or failed and are left out): Φ̄(W_T, u_TD) equals the result; "
+        "Φ̄(W_sT, u_TD) keeps the dynamic velocities with the static loads; Φ̄_lin makes each "
+        "contact linear in load (its static-load friction coefficient kept). Max load: the "
+        "largest total tooth force of the cycle over the static one.",
+        "",
+        "| rpm | status | Φ̄ TD (W) | recomputed (W) | static loads, TD velocities (W) | "
+        "linear in load (W) | Φ̄ QS (W) | TD/QS | lin/QS | max load / static |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for rpm, st, res, phi, phi_s, phi_l, qs, swing in rows:
+        if st != 0:
+            lines.append(
+                f"| {rpm:.0f} | {st} | {res:.1f} | — | — | — | {qs:.1f} | {res / qs - 1:+.1%} | — "
+                f"| — |"
+            )
+            continue
+        lines.append(
+            f"| {rpm:.0f} | {st} | {res:.1f} | {phi:.1f} | {phi_s:.1f} | {phi_l:.1f} | {qs:.1f} | "
+            f"{res / qs - 1:+.1%} | {phi_l / qs - 1:+.1%} | {swing:.2f} |"
+        )
+    ok = [r for r in rows if r[1] == 0]
+    concavity = np.array([(r[5] - r[3]) / r[6] for r in ok])  # (Φ̄_lin − Φ̄)/Φ̄_QS
+    velocity = np.array([(r[4] - r[6]) / r[6] for r in ok])  # static loads, TD velocities vs QS
+    lines += [
+        "",
+        f"Over the {len(ok)} status-0 speeds: the concavity lowers TD/QS by "
+        f"{100 * np.min(concavity):.1f}-{100 * np.max(concavity):.1f} points (median "
+        f"{100 * np.median(concavity):.1f}); the dynamic surface velocities alone move Φ̄ by "
+        f"{100 * np.min(velocity):+.1f} to {100 * np.max(velocity):+.1f} %; the rest of TD − QS is "
+        "where along the path the dynamic load goes (lin/QS). A contact law Φ ∝ W^k with k ≈ 0.6 "
+        f"also sets R7: 1500 N m against 700 N m gives Φ̄ × {(1500 / 700) ** 0.6:.2f} at k = 0.6, "
+        "below the torque ratio 2.14, so Ψ rises; the paper's lower Ψ needs k > 1.",
+    ]
+    write_section("load_convexity", "\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
