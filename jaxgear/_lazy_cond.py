@@ -15,7 +15,9 @@ import jax.custom_batching
 import jax.numpy as jnp
 
 
-def cond_any_member(pred, true_fn, false_fn, operand, *, all_true_path: bool = True):
+def cond_any_member(
+    pred, true_fn, false_fn, operand, *, all_true_path: bool = True, mixed: str = "select"
+):
     """``lax.cond(pred, true_fn, false_fn, operand)`` that stays lazy under ``vmap``.
 
     Under vmap, ``true_fn`` runs (batched) only when some member's predicate is true, and
@@ -30,7 +32,15 @@ def cond_any_member(pred, true_fn, false_fn, operand, *, all_true_path: bool = T
         all_true_path: under vmap, run ``true_fn`` alone (not the select) when every member takes
             it. That traces ``true_fn`` twice; pass False where it is expensive to compile and
             rarely taken by a whole batch.
+        mixed: what a batch whose predicates are mixed does. "select": both branches for every
+            member, batched (as plain vmap; right where the branches vectorise well). "map": one
+            member after another (``lax.map``), each a real cond, so only the members that take
+            a branch run it, unbatched: right for a long sequential branch (a time integration)
+            that few members of a large batch take, where the batched select would run it for
+            all of them.
     """
+    if mixed not in ("select", "map"):
+        raise ValueError(f"mixed = {mixed!r} is not valid; valid choices: 'select', 'map'")
     arrays, static = eqx.partition(operand, eqx.is_array)
     # a flat list of arrays: the JVP-of-vmap path of custom_vmap mishandles None leaves
     leaves, treedef = jax.tree.flatten(arrays)
@@ -51,6 +61,19 @@ def cond_any_member(pred, true_fn, false_fn, operand, *, all_true_path: bool = T
         arrays = jax.tree.map(widen, arrays, in_batched[1])
 
         def each(pa):
+            if mixed == "map":
+                # nested vmaps stay lazy: each member's cond is this one again
+                return jax.lax.map(
+                    lambda m: cond_any_member(
+                        m[0],
+                        branch(true_fn),
+                        branch(false_fn),
+                        m[1],
+                        all_true_path=False,
+                        mixed="map",
+                    ),
+                    pa,
+                )
             return jax.vmap(lambda p, a: jax.lax.cond(p, branch(true_fn), branch(false_fn), a))(*pa)
 
         def only(fn):

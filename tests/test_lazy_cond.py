@@ -90,3 +90,46 @@ def test_derivatives_are_those_of_lax_cond():
         assert float(diff(f)(0.4, False)) == 1.0
     g = jax.vmap(jax.grad(f))(jnp.asarray([0.4, 0.5]), jnp.asarray([True, False]))
     np.testing.assert_allclose(np.asarray(g), [3.0 * np.cos(0.4), 1.0], rtol=1e-14)
+
+
+def _recording():
+    seen = []
+
+    def expensive(op):
+        x, k = op
+        jax.debug.callback(lambda v: seen.append(np.asarray(v).copy()), x)
+        return jnp.sin(x) * k
+
+    return seen, expensive, lambda op: op[0]
+
+
+@pytest.mark.parametrize("mixed", ["select", "map"])
+def test_mixed_batch_map_runs_the_branch_only_for_the_members_that_take_it(mixed):
+    # What the coupled model's attractor branch needs in a vmapped sweep: 27 of 149 speeds take a
+    # 2000-cycle time integration, which the select ran batched for all 149 (benchmarks/RESULTS.md,
+    # accelerator: 615 s for the baseline sweep on 2 cores).
+    seen, expensive, cheap = _recording()
+    pred = jnp.asarray([False, True, False, True])
+    x = jnp.asarray([0.3, 1.1, -2.0, 0.7])
+    f = jax.jit(jax.vmap(lambda p, x: cond_any_member(p, expensive, cheap, (x, 2.0), mixed=mixed)))
+    out = jax.block_until_ready(f(pred, x))
+    np.testing.assert_allclose(np.asarray(out), np.where(pred, 2.0 * np.sin(x), x), rtol=1e-15)
+    values = np.concatenate([np.ravel(v) for v in seen])
+    if mixed == "map":
+        # one unbatched call per member that takes the branch, and none for the others
+        assert len(seen) == 2 and all(np.ndim(v) == 0 for v in seen)
+        np.testing.assert_array_equal(np.sort(values), np.sort(np.asarray(x)[np.asarray(pred)]))
+    else:
+        np.testing.assert_array_equal(np.sort(values), np.sort(np.asarray(x)))  # every member
+    # nested vmaps stay lazy with map: the all-false inner batch never runs the branch
+    seen.clear()
+    g = jax.jit(
+        jax.vmap(jax.vmap(lambda p, x: cond_any_member(p, expensive, cheap, (x, 2.0), mixed=mixed)))
+    )
+    pred2, x2 = pred.reshape(2, 2), x.reshape(2, 2)
+    out2 = jax.block_until_ready(g(pred2, x2))
+    np.testing.assert_allclose(np.asarray(out2), np.where(pred2, 2.0 * np.sin(x2), x2), rtol=1e-15)
+    if mixed == "map":
+        assert sorted(float(np.ravel(v)[0]) for v in seen) == sorted([1.1, 0.7])
+    with pytest.raises(ValueError, match="mixed"):
+        cond_any_member(True, expensive, cheap, (x, 2.0), mixed="both")
