@@ -22,7 +22,8 @@ def cond_any_member(
 
     Under vmap, ``true_fn`` runs (batched) only when some member's predicate is true, and
     ``false_fn`` only when some member's is false; nested vmaps recurse. When the predicates are
-    mixed, both run for every member (a select), as plain vmap would.
+    mixed, both run for every member (a select), as plain vmap would, or (``mixed="map"``) each
+    member runs its own branch, one after another.
 
     The branches must read only ``operand`` (batched values closed over are refused by
     custom_vmap); static values (Python objects, static Module fields) may be closed over.

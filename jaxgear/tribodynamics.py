@@ -585,8 +585,9 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     paper's stepwise speed increase: the gears carry their motion from speed to speed). Returns,
     besides the means, the (state, flag) to hand to the next point.
 
-    A vmap-lazy cond: a point with a stable orbit pays nothing, in a vmapped sweep too, unless
-    another point of its batch takes the branch (then every member runs it, a select)."""
+    A vmap-lazy cond: a point with a stable orbit pays nothing, in a vmapped sweep too; where a
+    batch mixes stable and unstable points, the unstable ones run the branch one by one
+    (``cond_any_member(..., mixed="map")``)."""
     from ._lazy_cond import cond_any_member
     from .dynamics.model import build_dynamics
     from .dynamics.response import DEFAULT_KICK, record_attractor

@@ -207,6 +207,12 @@ def test_sweep_sends_only_points_without_a_stable_orbit_to_the_attractor_slow():
     assert float(np.asarray(res.tooth_force)[1].sum(1).mean()) == pytest.approx(
         T1_OVER_RB1, rel=0.03
     )
+    # the mixed batch runs the attractor for its one unstable point alone (mixed="map"), as a
+    # single simulate does: the same record and means (batched and unbatched rounding only)
+    one = jg.simulate(PAIR, lub, surf, _op(3450.0), fid)
+    assert int(one.status) == STATUS_ATTRACTOR
+    assert float(res.power_loss[1]) == pytest.approx(float(one.power_loss), rel=1e-8)
+    assert float(res.dte_rms[1]) == pytest.approx(float(one.dte_rms), rel=1e-8)
 
 
 @pytest.mark.slow
