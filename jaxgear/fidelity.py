@@ -80,8 +80,11 @@ class Fidelity(eqx.Module):
             n_nodes ≳ 513 and does not converge in deep mixed lubrication). See EHLModel.mixed.
         shear: fluid shear law of the EHL rungs (``EHLModel.shear``): "eyring_paper" (the paper's
             η* = η/cosh(τm/τ0), Eq. 4: the fluid shear stress stays below τ0), "eyring_exact"
-            (τ = τ0 asinh(η us/(τ0 h)): grows without bound, logarithmically) or "newtonian".
-            REFERENCE §4 asks for both Eyring forms and the sensitivity of the loss to the choice.
+            (τ = τ0 asinh(η us/(τ0 h)): grows without bound, logarithmically), "eyring_split"
+            (the stress τm in the friction and sliding heat, η* = dτm/dγ̇, its tangent, in the
+            Reynolds flow coefficient, the Poiseuille heat and the damping) or "newtonian".
+            REFERENCE §4 asks for both Eyring forms and the sensitivity of the loss to the choice
+            (``benchmarks/shear_sensitivity.py``).
         asperity_density_product: nβσ of the statistical (Greenwood-Tripp) asperity model
             (``EHLModel.asperity_density_product``): summit density n (1/m²) × summit radius β (m)
             × composite roughness σ (m), dimensionless; valid range [1e-4, 1]. Of order a few
@@ -146,7 +149,11 @@ class Fidelity(eqx.Module):
         _choice("Fidelity.stiffness", self.stiffness, STIFFNESS_METHODS)
         _choice("Fidelity.backlash", self.backlash, ("exact", "smooth"))
         _choice("Fidelity.mixed_model", self.mixed_model, ("statistical", "deterministic"))
-        _choice("Fidelity.shear", self.shear, ("eyring_paper", "eyring_exact", "newtonian"))
+        _choice(
+            "Fidelity.shear",
+            self.shear,
+            ("eyring_paper", "eyring_exact", "eyring_split", "newtonian"),
+        )
         for name in ("thermal", "transient"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"Fidelity.{name} = {getattr(self, name)!r} must be True or False")

@@ -41,3 +41,84 @@ def test_shear_law_is_checked_and_read_from_toml():
     assert echo["shear"] == "eyring_exact"
     with pytest.raises(ValueError, match=r"fidelity\.shear"):
         fidelity_from_config({"fidelity": {"shear": "linear"}})
+
+
+def _formula(contact, shear):
+    from jaxgear.lubrication.ehl_formula import ehl_formula_contact
+
+    c = contact
+    return ehl_formula_contact(
+        c.reduced_radius, c.load_per_width, c.u1, c.u2, c.e_reduced, LUB, c.inlet_temperature,
+        0.0, shear=shear,
+    )  # fmt: skip
+
+
+def test_split_law_damping_is_the_tangent_of_its_traction():
+    """Eyring Couette shear τm = τ0 asinh(η us/(τ0 h)) has the tangent viscosity dτm/dγ̇ =
+    η/cosh(τm/τ0), the paper's η*: so under "eyring_split" (τm in the traction, η* in the damping)
+    the damping cm = ∫ η*/h dx must be the derivative of the fluid traction ∫ τm dx with respect to
+    the sliding speed at a fixed film. Checked on the closed-form contact (film set by the rolling
+    speed only) by automatic differentiation of the traction, which never evaluates η*; the traction
+    must equal the exact law's and the damping the paper law's (the same closed forms)."""
+    import jax
+    import jax.numpy as jnp
+    from ehl_cases import gear_contact
+
+    c = gear_contact(700.0, 2000.0, 0.3)
+    um, us0 = 0.5 * (float(c.u1) + float(c.u2)), float(c.u1) - float(c.u2)
+
+    def traction(us):
+        moved = jg.LineContact(
+            reduced_radius=c.reduced_radius, load_per_width=c.load_per_width, u1=um + us / 2,
+            u2=um - us / 2, e_reduced=c.e_reduced, inlet_temperature=c.inlet_temperature,
+        )  # fmt: skip
+        return -_formula(moved, "eyring_split").friction_sliding  # along u1 − u2
+
+    split = _formula(c, "eyring_split")
+    exact, paper = _formula(c, "eyring_exact"), _formula(c, "eyring_paper")
+    assert float(split.friction_sliding) == pytest.approx(float(exact.friction_sliding), rel=1e-12)
+    assert float(split.power_sliding) == pytest.approx(float(exact.power_sliding), rel=1e-12)
+    assert float(split.damping) == pytest.approx(float(paper.damping), rel=1e-12)
+    tangent = float(jax.grad(traction)(jnp.asarray(us0)))
+    # 1e-9: both sides are the same 24-point quadrature of analytic integrands
+    assert tangent == pytest.approx(float(split.damping), rel=1e-9)
+    # the secant (traction/us) is well above the tangent where the shear thins: the split's
+    # damping is not its traction over the sliding speed, as it is for the one-law options
+    assert float(traction(jnp.asarray(us0))) / us0 > 2.0 * tangent
+
+
+def test_split_law_in_the_ehl_solver():
+    """The EHL solver under "eyring_split": the film is the paper law's (the same flow coefficient
+    η*), so pressure and film equal it to solver tolerance and the damping too; the stress is the
+    exact Eyring τm = τ0 asinh(η us/(τ0 h)), recomputed here from the solution's own viscosity and
+    film by ``eyring_shear_stress``; the traction lies between the paper law's and the exact law's
+    on their own films (η* ≤ τm h/us, and the exact law's thicker-flow film differs by a few %)."""
+    import numpy as np
+    from ehl_cases import gear_contact
+
+    from jaxgear.lubrication.rheology import eyring_shear_stress
+
+    c = gear_contact(700.0, 2000.0, 0.3)
+    sols = {
+        law: jg.solve_ehl(c, LUB, jg.EHLModel(n_nodes=129, shear=law))
+        for law in ("eyring_paper", "eyring_exact", "eyring_split")
+    }
+    split, paper = sols["eyring_split"], sols["eyring_paper"]
+    assert all(bool(s.converged) for s in sols.values())
+    ph = float(split.hertz_pressure)
+    # 1e-9 ph / 1e-9 relative: the same discrete system to Newton tolerance
+    np.testing.assert_allclose(np.asarray(split.p), np.asarray(paper.p), atol=1e-9 * ph)
+    np.testing.assert_allclose(np.asarray(split.h), np.asarray(paper.h), rtol=1e-9)
+    assert float(split.damping) == pytest.approx(float(paper.damping), rel=1e-9)
+    us = abs(float(c.u1) - float(c.u2))
+    h = np.asarray(split.h)
+    inside = np.abs(np.asarray(split.x)) < float(split.hertz_half_width)
+    tau = np.asarray(split.shear_viscosity) * us / h
+    tau_ref = np.asarray(eyring_shear_stress(split.viscosity, us / h, LUB.eyring_stress))
+    # 2e-6: the solver shears the film h_eff = ½(h + √(h² + f²)) with a smooth floor f = 1e-3 of
+    # its reference film (reynolds.smooth_positive), h_eff/h − 1 ≈ f²/(4h²) ≈ 4e-7 here; a wrong
+    # law (η* or τm's log-space factor misplaced) is off by tens of percent
+    np.testing.assert_allclose(tau[inside], tau_ref[inside], rtol=2e-6)
+    f = {k: abs(float(s.friction_sliding)) for k, s in sols.items()}
+    assert f["eyring_paper"] < f["eyring_split"], f
+    assert f["eyring_split"] == pytest.approx(f["eyring_exact"], rel=0.1), f

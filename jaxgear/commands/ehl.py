@@ -96,7 +96,7 @@ def register(subparsers) -> None:
     p.add_argument("--nodes", type=int, dest="n_nodes", help="grid nodes (default 257)")
     p.add_argument("--viscosity", choices=("roelands", "barus"))
     p.add_argument("--compressibility", choices=("dowson_higginson", "incompressible"))
-    p.add_argument("--shear", choices=("newtonian", "eyring_paper", "eyring_exact"))
+    p.add_argument("--shear", choices=("newtonian", "eyring_paper", "eyring_exact", "eyring_split"))
     p.add_argument("--deformation", choices=("dense", "fft", "auto"))
     p.add_argument("--arrays", action="store_true", help="include x, p, h arrays in the JSON")
     p.add_argument("--png", help="write a figure of p(x) and h(x) to this file")

@@ -59,7 +59,7 @@ from .reynolds import (
 
 VISCOSITY_MODELS = ("roelands", "barus")
 COMPRESSIBILITY_MODELS = ("dowson_higginson", "incompressible")
-SHEAR_MODELS = ("newtonian", "eyring_paper", "eyring_exact")
+SHEAR_MODELS = ("newtonian", "eyring_paper", "eyring_exact", "eyring_split")
 DEFORMATION_METHODS = ("dense", "fft", "auto")
 MIXED_MODELS = ("deterministic", "statistical")
 
@@ -135,9 +135,12 @@ class EHLModel(eqx.Module):
             H_est the Moes central film in Hertz units (fully flooded inlet at low M).
         viscosity: "roelands" or "barus".
         compressibility: "dowson_higginson" or "incompressible".
-        shear: "newtonian", "eyring_paper" (η* = η/cosh(τm/τ0), paper Eq. 4) or "eyring_exact"
-            (τ = τ0 asinh(η us/(τ0 h))). It enters Reynolds' flow coefficient and the friction/heat
-            terms.
+        shear: "newtonian", "eyring_paper" (η* = η/cosh(τm/τ0), paper Eq. 4), "eyring_exact"
+            (τ = τ0 asinh(η us/(τ0 h))) or "eyring_split". It enters Reynolds' flow coefficient and
+            the friction/heat terms. η* is the tangent viscosity dτm/dγ̇ of Eyring Couette flow and
+            τm h/us its secant: "eyring_split" uses the secant (the stress τm) in the sliding
+            friction and heat, and η* in the flow coefficient, the Poiseuille heat and the damping
+            (the response to a small pressure flow or sliding-speed change on top of the shear).
         fb_smoothing: δ of the Fischer-Burmeister function.
         tolerance: ‖F‖∞ below which a Newton solve has converged.
         max_iterations: Newton iterations per grid level (and per continuation step).
@@ -265,7 +268,8 @@ class EHLSolution(eqx.Module):
     Attributes:
         x: node positions, m, (N,) (x = 0 at the Hertz centre, entrainment towards +x).
         p: pressure, Pa. h: film thickness, m. density: ρ, kg/m³. viscosity: η, Pa s.
-        shear_viscosity: η_s of the shear model (η, η* or τ h/us), Pa s.
+        shear_viscosity: η_s of the shear model's stress (η, η* or τ h/us), Pa s: friction
+            τ = η_s us/h.
         temperature: mean film temperature ϕm at the nodes, K (the inlet temperature: isothermal).
         surface_temperature1, surface_temperature2: surface temperatures of gear 1 and 2, K.
         heat_partition: ϑ = Q1/Q, share of the heat conducted into gear 1 (½ isothermal).
@@ -460,12 +464,18 @@ def _grid(sc: _Scales, n: int):
     return x, (sc.x_out - sc.x_in) / (n - 1)
 
 
-def _log_shear_factor(model: EHLModel, log_s):
+def _log_shear_factor(model: EHLModel, log_s, part: str = "flow"):
+    """ln(η_s/η) of the shear model for ``part`` "flow" (the Reynolds flow coefficient, the
+    Poiseuille heat, the damping) or "stress" (the sliding friction and heat): one law for both
+    except "eyring_split" (``ehl_formula.split_laws``)."""
+    from .ehl_formula import split_laws
     from .rheology import log_eyring_exact_factor, log_eyring_paper_factor
 
-    if model.shear == "eyring_paper":
+    stress_law, flow_law = split_laws(model.shear)
+    law = flow_law if part == "flow" else stress_law
+    if law == "eyring_paper":
         return log_eyring_paper_factor(log_s)
-    if model.shear == "eyring_exact":
+    if law == "eyring_exact":
         return log_eyring_exact_factor(log_s)
     return jnp.zeros_like(log_s)
 
@@ -1027,7 +1037,8 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     h_eff = smooth_positive(h, _FLOOR_FRACTION * sc.h_ref * h_scale)
     abs_us = jnp.sqrt(sc.us**2 + (1e-6 * sc.um) ** 2)
     log_s = log_eta + jnp.log(abs_us / (lub.eyring_stress * h_eff))
-    eta_s = jnp.exp(log_eta + _log_shear_factor(model, log_s))
+    eta_s = jnp.exp(log_eta + _log_shear_factor(model, log_s, "stress"))  # secant: τ h/|us|
+    eta_t = jnp.exp(log_eta + _log_shear_factor(model, log_s, "flow"))  # flow coefficient, damping
     # asperity contact (paper Eq. 4b/4c, 12, 15): boundary friction μb p on closed nodes
     if mixed == "deterministic":
         contact = _contact_indicator(model, sc, big_h)
@@ -1038,7 +1049,7 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     dpdx = jnp.gradient(p_dim, dx)
     # Fill fraction of the cavitated outlet: the mass flux through x = 0 carried as Couette streaks.
     rho_h = rho * h_eff
-    eps_flux = rho * h_eff**3 / (12.0 * eta_s) * dpdx
+    eps_flux = rho * h_eff**3 / (12.0 * eta_t) * dpdx
     q = jnp.interp(0.0, x, rho_h * sc.um - eps_flux)
     fill = jnp.where(x > 0.0, jnp.clip(q / (sc.um * rho_h), 0.0, 1.0), 1.0)
     weights = jnp.full((n,), dx).at[0].set(0.5 * dx).at[-1].set(0.5 * dx)
@@ -1046,7 +1057,7 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     q_asp = model.boundary_friction * (contact * p_dim + p_asp) * abs_us  # paper Eq. (12), h = 0
     # Poiseuille terms on cell faces, as the Reynolds discretisation has them (flow coefficient
     # averaged to the face, pressure gradient by the face difference)
-    flow = fluid * h_eff**3 / (12.0 * eta_s)
+    flow = fluid * h_eff**3 / (12.0 * eta_t)
     dp_face = jnp.diff(p_dim) / dx
     q_roll_face = 0.5 * (flow[1:] + flow[:-1]) * dp_face**2  # paper Eq. (12), rolling part
     q_roll = 0.5 * (jnp.pad(q_roll_face, (1, 0)) + jnp.pad(q_roll_face, (0, 1)))
@@ -1056,7 +1067,7 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     fs_asp = jnp.sum(weights * model.boundary_friction * (contact * p_dim + p_asp)) * sign
     h_face = 0.5 * (h[1:] + h[:-1]) * 0.5 * (fluid[1:] + fluid[:-1])
     fr = jnp.sum(0.5 * h_face * jnp.diff(p_dim))
-    cm = jnp.sum(weights * fluid * fill * eta_s / h_eff)  # paper Eq. (13) per unit width
+    cm = jnp.sum(weights * fluid * fill * eta_t / h_eff)  # paper Eq. (13) per unit width
     # sub-grid minimum film by a parabola through the smallest node and its neighbours
     i = jnp.clip(jnp.argmin(big_h), 1, n - 2)
     hm, h_0, hp = big_h[i - 1], big_h[i], big_h[i + 1]

@@ -44,7 +44,19 @@ _GAP_T, _GAP_W = np.polynomial.legendre.leggauss(24)
 ROLLING_TRACTION = (4.318, 0.658, 0.0126)
 #: Pan & Hamrock (1989) central film, h_c/R = C W′^a U^b G^c (REFERENCE §8).
 PAN_HAMROCK_CENTRAL = (2.922, -0.166, 0.692, 0.470)
-SHEAR_LAWS = ("eyring_paper", "eyring_exact", "newtonian")
+SHEAR_LAWS = ("eyring_paper", "eyring_exact", "eyring_split", "newtonian")
+
+
+def split_laws(shear: str) -> tuple[str, str]:
+    """(law of the shear stress, law of the flow and damping) of a shear option.
+
+    "eyring_split": the Eyring stress τm = τ0 asinh(η us/(τ0 h)) (the secant viscosity τm h/us) in
+    the friction and the sliding heat, and the tangent viscosity dτm/dγ̇ = η/cosh(τm/τ0) (the paper's
+    η*) in the Reynolds flow coefficient, the Poiseuille heat and the damping (REFERENCE §4). The
+    other options use one law for all."""
+    if shear == "eyring_split":
+        return "eyring_exact", "eyring_paper"
+    return shear, shear
 
 
 class FormulaContact(eqx.Module):
@@ -118,7 +130,9 @@ def ehl_formula_contact(
         reduced_radius: R, m. load_per_width: w, N/m (> 0). u1, u2: surface velocities, m/s
             (u1 + u2 > 0). e_reduced: E′, Pa. lubricant: Lubricant (η0, α, τ0 at the inlet).
         inlet_temperature: K. composite_rq: σ, m (0 for smooth surfaces: no asperity load).
-        boundary_friction: μb. shear: "eyring_paper", "eyring_exact" or "newtonian".
+        boundary_friction: μb. shear: "eyring_paper", "eyring_exact", "eyring_split" (the Eyring
+            stress in the traction, its tangent viscosity η* in the damping: ``split_laws``) or
+            "newtonian".
         density_product, slope_ratio: nβσ and σ/β of the Greenwood-Tripp model.
         sign_width: sliding speed over which the boundary friction's sign turns, m/s (default 1 %
             of u1 + u2); the fluid part needs none (the shear law is smooth through us = 0).
@@ -167,10 +181,17 @@ def ehl_formula_contact(
     x = _ZONE_X
     p_f = ((1.0 - share) * ph)[..., None] * jnp.sqrt(1.0 - x * x)
     eta = lubricant.viscosity(p_f, inlet_temperature, viscosity_model)
-    eta_s = _shear(eta, abs_us[..., None], h_c[..., None], tau0, shear)
-    shear_integral = b * jnp.sum(_ZONE_W * eta_s, axis=-1)  # ∫ η_s dx, Pa s m
-    damping = shear_integral / h_c
-    fluid = damping * (u2 - u1)
+    stress_law, flow_law = split_laws(shear)
+    eta_s = _shear(eta, abs_us[..., None], h_c[..., None], tau0, stress_law)
+    secant = (
+        b * jnp.sum(_ZONE_W * eta_s, axis=-1) / h_c
+    )  # ∫ η_s dx / h_c: traction per sliding speed
+    if flow_law == stress_law:
+        damping = secant
+    else:
+        eta_t = _shear(eta, abs_us[..., None], h_c[..., None], tau0, flow_law)
+        damping = b * jnp.sum(_ZONE_W * eta_t, axis=-1) / h_c
+    fluid = secant * (u2 - u1)
     width = 0.01 * (u1 + u2) if sign_width is None else sign_width
     sign = smooth_sign(u2 - u1, width)
     asperity = boundary_friction * w_a * sign
@@ -183,6 +204,6 @@ def ehl_formula_contact(
         friction_asperity=asperity,
         friction_rolling=rolling,
         damping=damping,
-        power_sliding=damping * us * us + asperity * (u2 - u1),
+        power_sliding=secant * us * us + asperity * (u2 - u1),
         power_rolling=rolling * (u1 + u2),
     )
