@@ -18,7 +18,9 @@ paper fidelity's Φ̄ within 6.1 % over the baseline sweep):
    coefficient of the static load kept). The ratio Φ̄_lin/Φ̄(W_T, u_TD) is what the concavity costs.
 
 3. self-consistent runs on the ladder's rungs whose contact law has another load exponent: the
-   regression formula (Xu et al. 2007) and constant μ (k = 1), for k and TD/QS at the speeds of A-E.
+   regression formula (Xu et al. 2007), constant μ (k = 1) and the fast rung with the Eyring stress
+   τm as the fluid traction (``shear="eyring_split"``; the paper's η* caps it at τ0), for k and TD/QS
+   at the speeds of A-E.
 
 Writes the section ``load_convexity`` of benchmarks/RESULTS.md. Run (repository root), ~5 min:
     python benchmarks/load_convexity.py
@@ -147,6 +149,7 @@ RUNGS = (
     ("fast() (ehl_formula)", FID),
     ("regression (Xu 2007)", FID.replace(friction="regression")),
     ("constant μ = 0.03", FID.replace(friction="constant", constant_mu=0.03)),
+    ("fast(), Eyring split (τm traction)", FID.replace(shear="eyring_split")),
 )
 RUNG_SPEEDS = (1700.0, 1800.0, 2600.0, 3300.0, 3400.0, 3500.0)
 
@@ -255,7 +258,8 @@ def main():
         "orbit; cold single points; ‡ mean over an attractor, † not converged). k from the "
         "quasi-static Φ̄ at 1500 against 700 N m (mean over 1000, 2500, 3500 rpm); TD/QS at the "
         "speeds of A-E. The regression and constant-μ rungs carry no EHL damping, so their "
-        "resonances differ as well:",
+        "resonances differ as well; the Eyring-split rung keeps the fast rung's damping (η*) and "
+        "takes the stress τm = τ0 asinh(η us/(τ0 h)) as its traction:",
         "",
         "| rung | k (700 → 1500 N m) | "
         + " | ".join(f"TD/QS {r:.0f} rpm" for r in RUNG_SPEEDS)
