@@ -98,6 +98,11 @@ class Fidelity(eqx.Module):
             deep mixed lubrication. The mesh loss depends on them only through K′; the paper's
             quasi-static losses need K′ ≈ 2.4-2.9 × the default's, e.g. nβσ ≈ 0.08 (measured:
             ``benchmarks/friction_sensitivity.py``; the defaults are not fitted to the paper).
+        limiting_shear_coefficient: Λ of a limiting shear stress τL = Λ p (Bair & Winer) that caps
+            the fluid traction and sliding heat of the EHL rungs and the closed-form rung
+            (``EHLModel.limiting_shear_coefficient``), valid range [1e-6, 1]; None (default): no
+            cap, the paper's model. Not in the paper: a traction that grows with load but not
+            with the inlet viscosity (see ``benchmarks/shear_sensitivity.py``).
         attractor_periods: where the tribo-dynamic fixed point ends without a stable periodic
             orbit (a parametric instability band, or rattling through the backlash), the gears
             settle on another attractor (a period-doubled orbit, a torus, a chaotic rattle): the
@@ -139,6 +144,7 @@ class Fidelity(eqx.Module):
     shear: str = _static("eyring_paper")
     asperity_density_product: float = _static(0.05)
     asperity_slope_ratio: float = _static(0.01)
+    limiting_shear_coefficient: float | None = _static(None)
     attractor_periods: int = _static(256)
     settle_periods: int = _static(2000)
 
@@ -174,6 +180,10 @@ class Fidelity(eqx.Module):
         # the ranges of EHLModel.__check_init__
         _float_in("Fidelity.asperity_density_product", self.asperity_density_product, 1e-4, 1.0)
         _float_in("Fidelity.asperity_slope_ratio", self.asperity_slope_ratio, 1e-6, 1.0)
+        if self.limiting_shear_coefficient is not None:
+            _float_in(
+                "Fidelity.limiting_shear_coefficient", self.limiting_shear_coefficient, 1e-6, 1.0
+            )
         if self.fixed_point_tolerance is not None:
             _float_in("Fidelity.fixed_point_tolerance", self.fixed_point_tolerance, 1e-14, 0.1)
         _float_in("Fidelity.relaxation", self.relaxation, 1e-3, 1.0)

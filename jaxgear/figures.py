@@ -437,6 +437,7 @@ def _solve_contact(repro, result, index, i, slot, label, deterministic=False):
             thermal=False,
             boundary_friction=fid.boundary_friction,
             shear=fid.shear,
+            limiting_shear_coefficient=fid.limiting_shear_coefficient,
         )
         what = (
             f"deterministic roughness, {FIELD_DETERMINISTIC_NODES} nodes, steady, iso-thermal "

@@ -2,6 +2,7 @@
 asks for the paper's η* and the exact Eyring law, and the sensitivity of the loss to the choice:
 ``benchmarks/shear_sensitivity.py``)."""
 
+import numpy as np
 import pytest
 
 import jaxgear as jg
@@ -122,3 +123,78 @@ def test_split_law_in_the_ehl_solver():
     f = {k: abs(float(s.friction_sliding)) for k, s in sols.items()}
     assert f["eyring_paper"] < f["eyring_split"], f
     assert f["eyring_split"] == pytest.approx(f["eyring_exact"], rel=0.1), f
+
+
+def test_limiting_shear_stress_closed_forms():
+    """The smooth cap τ/(1 + (τ/τL)^8)^(1/8), τL = Λ p: the law's stress well below τL, τL well
+    above it, finite derivatives where the pressure vanishes; and in the capped limit the closed-form
+    contact's fluid traction is Λ times the fluid load (the Bair-Winer limit: friction linear in
+    load), its damping untouched."""
+    import jax
+    import jax.numpy as jnp
+    from ehl_cases import gear_contact
+
+    from jaxgear.lubrication.ehl_formula import ehl_formula_contact
+    from jaxgear.lubrication.rheology import log_limited_stress
+
+    lam, p = 0.05, 1e9  # τL = 50 MPa
+
+    def capped(tau, p=p):
+        return float(jnp.exp(log_limited_stress(jnp.log(tau), p, lam, 1.0)))
+
+    assert capped(5e6) == pytest.approx(5e6, rel=1e-8)  # (τ/τL)^8/8 = 1.3e-9
+    assert capped(5e9) == pytest.approx(5e7, rel=1e-8)
+    assert capped(5e7) == pytest.approx(5e7 * 2.0**-0.125, rel=1e-12)
+    g = jax.grad(lambda q: jnp.exp(log_limited_stress(jnp.log(1e6), q, lam, 1.0)))(0.0)
+    assert np.isfinite(float(g))
+
+    def fluid(torque, limit):
+        c = gear_contact(torque, 2000.0, 0.3)
+        f = ehl_formula_contact(
+            c.reduced_radius, c.load_per_width, c.u1, c.u2, c.e_reduced, LUB, c.inlet_temperature,
+            0.0, shear="eyring_split", limiting_shear=limit,
+        )  # fmt: skip
+        return abs(float(f.friction_sliding - f.friction_asperity)), float(f.damping), c
+
+    t_free, d_free, c = fluid(700.0, None)
+    t_cap, d_cap, _ = fluid(700.0, 0.005)
+    t_cap2, _, c2 = fluid(1400.0, 0.005)
+    w, w2 = float(c.load_per_width), float(c2.load_per_width)
+    # measured 0.989 and 0.997 of Λw: the Hertz-zone edges, where the pressure and the
+    # (Newtonian) stress both vanish, stay under the cap; 3 % leaves room for that, not for a law
+    # that misses the cap (the uncapped traction is 2.6 Λw here)
+    assert 0.97 * 0.005 * w < t_cap <= 0.005 * w
+    assert 0.97 * 0.005 * w2 < t_cap2 <= 0.005 * w2
+    assert t_free > 2.0 * 0.005 * w
+    assert d_cap == pytest.approx(d_free, rel=1e-12)
+    t_loose, _, _ = fluid(700.0, 1.0)  # τL = p ≫ τm: the cap does not bind
+    assert t_loose == pytest.approx(t_free, rel=1e-6)
+
+
+def test_limiting_shear_stress_in_the_ehl_solver():
+    """The EHL solver's traction under a binding cap (Λ = 0.005, smooth surfaces) is Λ times the
+    load to within the contact edges' share, and the film is untouched (the cap acts on the
+    friction and sliding heat only)."""
+    from ehl_cases import gear_contact
+
+    c = gear_contact(700.0, 2000.0, 0.3)
+    free = jg.solve_ehl(c, LUB, jg.EHLModel(n_nodes=129, shear="eyring_split"))
+    capped = jg.solve_ehl(
+        c, LUB, jg.EHLModel(n_nodes=129, shear="eyring_split", limiting_shear_coefficient=0.005)
+    )
+    assert bool(capped.converged)
+    w = float(c.load_per_width)
+    ratio = abs(float(capped.friction_sliding)) / (0.005 * w)
+    # the inlet and outlet where p → 0 carry little stress either way: 0.95-1 of Λw
+    assert 0.95 < ratio <= 1.0, ratio
+    assert abs(float(free.friction_sliding)) > 2.0 * 0.005 * w
+    assert float(capped.h_central) == pytest.approx(float(free.h_central), rel=1e-9)
+    assert float(capped.damping) == pytest.approx(float(free.damping), rel=1e-9)
+    us = abs(float(c.u1) - float(c.u2))
+    assert float(capped.power_loss_sliding) == pytest.approx(
+        abs(float(capped.friction_sliding)) * us, rel=1e-6
+    )
+    with pytest.raises(ValueError, match=r"EHLModel\.limiting_shear_coefficient = 0 .*\(0, 1\]"):
+        jg.EHLModel(limiting_shear_coefficient=0.0)
+    with pytest.raises(ValueError, match=r"Fidelity\.limiting_shear_coefficient = 2\.0"):
+        jg.Fidelity(limiting_shear_coefficient=2.0)

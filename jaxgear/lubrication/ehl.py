@@ -180,6 +180,10 @@ class EHLModel(eqx.Module):
         asperity_density_product, asperity_slope_ratio: nβσ and σ/β of the statistical model
             [typical values for ground steel: 0.05, 0.01].
         asperity_relaxation: under-relaxation of the asperity-pressure update (statistical).
+        limiting_shear_coefficient: Λ of a limiting shear stress τL = Λ p (Bair & Winer) capping,
+            smoothly, the fluid shear stress of the friction and the sliding heat at the local
+            fluid pressure (``rheology.log_limited_stress``), in (0, 1]; None (default): no cap.
+            Typical Λ 0.03-0.1. The flow coefficient and the damping keep the shear law's.
     """
 
     n_nodes: int = eqx.field(static=True, default=257)
@@ -206,6 +210,7 @@ class EHLModel(eqx.Module):
     asperity_density_product: float = eqx.field(static=True, default=0.05)
     asperity_slope_ratio: float = eqx.field(static=True, default=0.01)
     asperity_relaxation: float = eqx.field(static=True, default=0.5)
+    limiting_shear_coefficient: float | None = eqx.field(static=True, default=None)
 
     def __check_init__(self):
         if not isinstance(self.n_nodes, int) or self.n_nodes < 17:
@@ -226,6 +231,14 @@ class EHLModel(eqx.Module):
         check_range("EHLModel.asperity_density_product", self.asperity_density_product, 1e-4, 1.0)
         check_range("EHLModel.asperity_slope_ratio", self.asperity_slope_ratio, 1e-6, 1.0)
         check_range("EHLModel.asperity_relaxation", self.asperity_relaxation, 0.01, 1.0)
+        if self.limiting_shear_coefficient is not None:
+            check_range(
+                "EHLModel.limiting_shear_coefficient",
+                self.limiting_shear_coefficient,
+                0.0,
+                1.0,
+                low_inclusive=False,
+            )
         check_range("EHLModel.fb_smoothing", self.fb_smoothing, 0.0, 1e-2, low_inclusive=False)
         check_range("EHLModel.tolerance", self.tolerance, 0.0, 1e-2, low_inclusive=False)
         for name in ("thermal", "auto_domain"):
@@ -1037,7 +1050,14 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     h_eff = smooth_positive(h, _FLOOR_FRACTION * sc.h_ref * h_scale)
     abs_us = jnp.sqrt(sc.us**2 + (1e-6 * sc.um) ** 2)
     log_s = log_eta + jnp.log(abs_us / (lub.eyring_stress * h_eff))
-    eta_s = jnp.exp(log_eta + _log_shear_factor(model, log_s, "stress"))  # secant: τ h/|us|
+    log_eta_s = log_eta + _log_shear_factor(model, log_s, "stress")  # secant: τ h/|us|
+    if model.limiting_shear_coefficient is not None:  # τ ≤ τL = Λ p (smooth); not the damping
+        log_rate = jnp.log(abs_us / h_eff)
+        log_tau = rheology.log_limited_stress(
+            log_eta_s + log_rate, p_dim, model.limiting_shear_coefficient, 1e-6 * sc.ph
+        )
+        log_eta_s = log_tau - log_rate
+    eta_s = jnp.exp(log_eta_s)
     eta_t = jnp.exp(log_eta + _log_shear_factor(model, log_s, "flow"))  # flow coefficient, damping
     # asperity contact (paper Eq. 4b/4c, 12, 15): boundary friction μb p on closed nodes
     if mixed == "deterministic":

@@ -34,6 +34,7 @@ from jaxtyping import Array, Float
 
 from .asperity import asperity_pressure
 from .friction_models import smooth_sign
+from .rheology import log_limited_stress
 
 # Gauss-Legendre nodes on [-1, 1]: the Hertz zone (fluid traction, asperity load on the flat film) and
 # the opening gap outside it (asperity load).
@@ -123,6 +124,7 @@ def ehl_formula_contact(
     slope_ratio: float = 0.01,
     sign_width=None,
     viscosity_model: str = "roelands",
+    limiting_shear: float | None = None,
 ) -> FormulaContact:
     """Friction, damping and power loss of loaded line contacts by the closed-form EHL model.
 
@@ -137,6 +139,8 @@ def ehl_formula_contact(
         sign_width: sliding speed over which the boundary friction's sign turns, m/s (default 1 %
             of u1 + u2); the fluid part needs none (the shear law is smooth through us = 0).
         viscosity_model: "roelands" or "barus".
+        limiting_shear: Λ of a limiting shear stress τL = Λ p_f that caps the traction (smoothly,
+            ``rheology.log_limited_stress``), or None (no cap). The damping is not capped.
 
     Returns:
         FormulaContact, per unit width.
@@ -182,15 +186,17 @@ def ehl_formula_contact(
     p_f = ((1.0 - share) * ph)[..., None] * jnp.sqrt(1.0 - x * x)
     eta = lubricant.viscosity(p_f, inlet_temperature, viscosity_model)
     stress_law, flow_law = split_laws(shear)
-    eta_s = _shear(eta, abs_us[..., None], h_c[..., None], tau0, stress_law)
-    secant = (
-        b * jnp.sum(_ZONE_W * eta_s, axis=-1) / h_c
-    )  # ∫ η_s dx / h_c: traction per sliding speed
-    if flow_law == stress_law:
-        damping = secant
-    else:
-        eta_t = _shear(eta, abs_us[..., None], h_c[..., None], tau0, flow_law)
-        damping = b * jnp.sum(_ZONE_W * eta_t, axis=-1) / h_c
+    shear_args = (eta, abs_us[..., None], h_c[..., None], tau0)
+    eta_s = _shear(*shear_args, stress_law)  # secant: the traction's viscosity τ h/|us|
+    eta_t = eta_s if flow_law == stress_law else _shear(*shear_args, flow_law)  # damping's
+    if limiting_shear is not None:  # the traction capped at τL = Λ p_f; the damping is not
+        rate = jnp.maximum(abs_us, 1e-12)[..., None] / h_c[..., None]
+        floor = 1e-6 * ph[..., None]
+        eta_s = (
+            jnp.exp(log_limited_stress(jnp.log(eta_s * rate), p_f, limiting_shear, floor)) / rate
+        )
+    secant = b * jnp.sum(_ZONE_W * eta_s, axis=-1) / h_c  # traction per sliding speed, ∫ η_s dx/h_c
+    damping = b * jnp.sum(_ZONE_W * eta_t, axis=-1) / h_c
     fluid = secant * (u2 - u1)
     width = 0.01 * (u1 + u2) if sign_width is None else sign_width
     sign = smooth_sign(u2 - u1, width)
