@@ -208,7 +208,7 @@ def trends(density_product=None):
         f"R3 TD/QS at {', '.join(f'{v:.0f}' for v in r3_speeds)} rpm |",
         "|---|---|---|---|---|---|",
     ]
-    for shear in SHEARS:
+    for shear in shears:
 
         def ratio(label, rpm, shear=shear):
             return loss[(shear, label, rpm)][0] / loss[(shear, "baseline", rpm)][0]
