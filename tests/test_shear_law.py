@@ -198,3 +198,33 @@ def test_limiting_shear_stress_in_the_ehl_solver():
         jg.EHLModel(limiting_shear_coefficient=0.0)
     with pytest.raises(ValueError, match=r"Fidelity\.limiting_shear_coefficient = 2\.0"):
         jg.Fidelity(limiting_shear_coefficient=2.0)
+
+
+def test_eyring_stress_traction_is_convex_in_load_and_follows_the_viscosity():
+    """Why the two readings give different trends (README, known open points: the fluid shear law).
+    The η* traction is capped at τ0 over the Hertz width 2b ∝ √w, so it grows slower than the load
+    (exponent ≈ ½) and hardly with the inlet viscosity; the Eyring stress τm ≈ τ0 ln(2ηγ̇/τ0) grows
+    with ln η, which is ≈ α p, so its traction grows faster than the load and rises with the inlet
+    viscosity (60 °C against 90 °C). Closed-form contact, smooth, pitch, 2000 rpm, slide-to-roll 0.3;
+    measured: exponents 0.60 and 1.26, 60 °C ratios 1.06 and 1.49; the bounds sit halfway."""
+    from ehl_cases import gear_contact
+
+    from jaxgear.lubrication.ehl_formula import ehl_formula_contact
+
+    def traction(torque, t_in, law):
+        c = gear_contact(torque, 2000.0, 0.3, t_in=t_in)
+        f = ehl_formula_contact(
+            c.reduced_radius, c.load_per_width, c.u1, c.u2, c.e_reduced, LUB, t_in, 0.0, shear=law
+        )
+        return abs(float(f.friction_sliding - f.friction_asperity))
+
+    def exponent(law):
+        return np.log(traction(1400.0, 363.15, law) / traction(700.0, 363.15, law)) / np.log(2.0)
+
+    def colder(law):
+        return traction(700.0, 333.15, law) / traction(700.0, 363.15, law)
+
+    assert exponent("eyring_paper") < 0.75
+    assert exponent("eyring_split") > 1.1
+    assert colder("eyring_paper") < 1.15
+    assert colder("eyring_split") > 1.3
