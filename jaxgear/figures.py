@@ -174,7 +174,8 @@ def reproduce_paper(
             the ends of the sweep), 24 positions per mesh cycle, independent points (parallel mode).
         speeds_rpm: baseline speeds, rpm (default the paper's 500-4200 rpm in 25 rpm steps).
         variant_speeds_rpm: speeds of the variant sweeps, rpm (default every 100 rpm of the
-            baseline range; the quick speeds when ``quick``).
+            baseline range; the quick speeds when ``quick``). Speed E is added when the baseline
+            grid places it between two of them (at its DTE peak), for Fig. 12 and R10.
         mode: "continuation" (the paper's stepwise speed increase; default) or "parallel" (default
             when ``quick``) for the tribo-dynamic sweeps.
         pair: GearPair (default ``presets.li2015_pair_calibrated()``); lubricant (default
@@ -240,6 +241,7 @@ def reproduce_paper(
     td = run("tribo_dynamic", speeds, fid, mode)
     qs = run("quasi_static", speeds, fid.replace(dynamics="quasi_static"), "parallel")
     points, source = _place_points(speeds, td)
+    variant_speeds = _with_speed_e(variant_speeds, float(speeds[points["E"]]))
 
     variants: dict[str, Any] = {}
     subset = _indices_of(speeds, variant_speeds)
@@ -308,6 +310,17 @@ def _speed_array(name, values) -> np.ndarray:
 def _every_100_rpm(speeds):
     grid = np.arange(math.ceil(speeds[0] / 100.0) * 100.0, speeds[-1] + 1e-9, 100.0)
     return grid if grid.size else speeds
+
+
+def _with_speed_e(variant_speeds, e_speed):
+    """The variant speeds with speed E added when it lies strictly between two of them. Fig. 12 and
+    R10 compare the ground and polished contacts at E; a fine baseline grid places E at its DTE
+    peak, usually between the variant speeds (3375 rpm on the paper's 25 rpm grid against variants
+    every 100 or 200 rpm). Outside their range it is not added: a continuation sweep would jump."""
+    v = np.asarray(variant_speeds, dtype=float)
+    if _indices_of(v, np.asarray([e_speed])) is not None or not (v[0] < e_speed < v[-1]):
+        return v
+    return np.union1d(v, [e_speed])
 
 
 def _indices_of(speeds, wanted):

@@ -324,3 +324,17 @@ def test_fig12_solves_the_roughness_deterministically_on_the_mixed_rung():
     assert float(p.solution.p_max) < 2.0e9 and float(p.solution.h_min) > 0.0  # full film
     fig = jg.figures.figure(repro, 12)
     assert len(fig.axes) == 4  # p and h, ground and polished; iso-thermal: no temperature row
+
+
+def test_speed_e_joins_the_variant_speeds_only_between_them():
+    # Fig. 12 / R10 need the polished variant at speed E. On the paper's 25 rpm grid E sits at the
+    # DTE peak (3375 rpm), between the variants' 100 or 200 rpm steps: it is added there, in order.
+    from jaxgear.figures import _with_speed_e
+
+    v = np.arange(500.0, 4201.0, 200.0)
+    added = _with_speed_e(v, 3375.0)
+    assert added.size == v.size + 1 and 3375.0 in added
+    assert np.all(np.diff(added) > 0)
+    # already a variant speed, or outside their range (a continuation sweep would jump): unchanged
+    for e in (3300.0, 450.0, 4300.0):
+        assert np.array_equal(_with_speed_e(v, e), v)
