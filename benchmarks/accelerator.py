@@ -112,6 +112,11 @@ def main(argv=None):
     ap.add_argument("--paper", action="store_true", help="also one speed at Fidelity.paper()")
     ap.add_argument("--ehl", action="store_true", help="also the EHL kernel (solve_ehl) alone")
     ap.add_argument("--skip-sweeps", action="store_true", help="no fast() sweeps")
+    ap.add_argument(
+        "--modes",
+        default="parallel,continuation",
+        help="comma-separated sweep modes to time, in this order",
+    )
     ap.add_argument("--compare", help="JSON from another backend's run: Φ̄ differences")
     ap.add_argument("--speeds", type=int, default=len(SPEEDS), help="first N baseline speeds")
     ap.add_argument("--section", action="store_true", help="write the RESULTS.md section")
@@ -150,7 +155,7 @@ def main(argv=None):
             with open(args.out, "w") as f:
                 json.dump(record, f)
 
-    for mode in () if args.skip_sweeps else ("parallel", "continuation"):
+    for mode in () if args.skip_sweeps else args.modes.split(","):
         (res, _), first = _timed(lambda s, m=mode: _sweep(m, s), speeds)
         (_, _), again = _timed(lambda s, m=mode: _sweep(m, s), speeds + 1e-3)
         counts = (
