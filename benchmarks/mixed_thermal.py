@@ -7,6 +7,13 @@ are timed separately. Writes the ``mixed_thermal`` section of benchmarks/RESULTS
 
 Run: ``python benchmarks/mixed_thermal.py [--repeats 3] [--steps 40]``
 
+``--engagement``: one whole engagement actually marched (not extrapolated from a few steps): the
+~900 grid-tied steps of the smooth, statistical thermal and deterministic passages at 500 and
+3500 rpm, with the memory XLA reserves for the compiled passage (arguments, outputs,
+temporaries) and the process's peak resident memory; the deterministic passage runs along the
+path only (the pitch-point contact held costs as much a step).
+Writes the ``mixed_engagement`` section.
+
 ``--passage-iterations``: where the deterministic passage spends its time: the Newton iterations
 of each step (all attempts) with the warm-start budget of the default model (12) and with 60, at
 500 and 3500 rpm on 257 nodes; writes the ``mixed_passage_iterations`` section.
@@ -46,7 +53,14 @@ def main(argv=None):
         action="store_true",
         help="per-step Newton iterations of the deterministic passage",
     )
+    ap.add_argument(
+        "--engagement",
+        action="store_true",
+        help="one whole engagement marched, with its memory",
+    )
     args = ap.parse_args(argv)
+    if args.engagement:
+        return engagement()
     if args.passage_iterations:
         return passage_iterations(args.steps)
     surf = jg.presets.ground()
@@ -86,8 +100,10 @@ def main(argv=None):
                 cs, LUB, model, s, times=t
             )
             first, run = time_call(fn, contacts, times, repeats=1)
-            # one engagement of the paper's pair: the roughness travels ~15 mm of surface
-            steps_engagement = 15e-3 / (float(c.rolling_velocity) * dt)
+            # one engagement of the paper's pair: the contact crosses the 15.5 mm path of contact
+            # while each surface rolls ~5.6 mm through it (ur = ω L/2 < rb ω); until 11-26 this
+            # took 15 mm of rolling, 2.7× too many steps
+            steps_engagement = _path_contacts(rpm, model)[1].shape[0]
             prow.append(
                 f"| {label} | {rpm:.0f} | {first:.0f} | {run / k * 1e3:.0f} | "
                 f"{steps_engagement:.0f} | {run / k * steps_engagement:.0f} |"
@@ -106,7 +122,8 @@ def main(argv=None):
             *rows,
             "",
             f"Transient passage, 257 nodes, {args.steps} steps timed (Δt = Δx/ur); one engagement "
-            "extrapolated to the ~15 mm of surface that passes the contact:",
+            "extrapolated from them (its steps: the 15.5 mm path of contact crossed at "
+            "rb ω1 while the surfaces roll ~5.6 mm at ur):",
             "",
             "| model | rpm | compile+first, s | per step, ms | steps per engagement | "
             "engagement, s |",
@@ -115,6 +132,127 @@ def main(argv=None):
         ]
     )
     write_section("mixed_thermal", body)
+
+
+def _mib(nbytes):
+    return nbytes / 2**20
+
+
+def _path_contacts(rpm, model):
+    """The contact states of one tooth pair's whole engagement on the paper's calibrated pair
+    (700 N m, 90 °C), quasi-static load sharing, at the time steps Δt = Δx/ur of the pitch-point
+    contact: (contacts, times, Δt)."""
+    import numpy as np
+
+    from jaxgear.material import reduced_modulus
+
+    pair = jg.presets.li2015_pair_calibrated()
+    m = 256
+    mc = jg.mesh_cycle(pair, 700.0, n_positions=m)
+    geo = jg.gear_geometry(pair)
+    # slot 0 over one mesh period, then slot 1 over the next: one pair's engagement
+    seq = lambda a: np.concatenate([np.asarray(a)[:, 0], np.asarray(a)[:, 1]])  # noqa: E731
+    s_path, w_path, on = seq(mc.contact_position), seq(mc.normal_load), seq(mc.in_contact)
+    # the loaded part (the smoothed contact edges carry no load at their ends)
+    keep = (on > 0.5) & (w_path > 0.01 * w_path.max())
+    s_path, w_path = s_path[keep], w_path[keep]
+    omega1 = rpm * 2.0 * np.pi / 60.0
+    t_path = (s_path - s_path[0]) / (float(geo.base_radius[0]) * omega1)
+    dt = float(grid_time_step(gear_contact(rpm=rpm), LUB, model))
+    times = np.arange(0.0, t_path[-1], dt)
+    s_t = np.interp(times, t_path, s_path)
+    kin = jg.kinematics(pair, geo, jnp.asarray(s_t), omega1)
+    rho1, rho2 = s_t, float(geo.line_of_action_length) - s_t
+    k = times.shape[0]
+    contacts = jg.LineContact(
+        reduced_radius=jnp.asarray(rho1 * rho2 / (rho1 + rho2)),
+        load_per_width=jnp.asarray(np.interp(times, t_path, w_path) / float(pair.face_width)),
+        u1=kin.u1,
+        u2=kin.u2,
+        e_reduced=jnp.full((k,), float(reduced_modulus(*pair.materials))),
+        inlet_temperature=jnp.full((k,), 363.15),
+    )
+    return contacts, jnp.asarray(times), dt
+
+
+def engagement():
+    """One engagement marched step by step (Δt = Δx/ur of the pitch-point contact, for the time
+    the contact takes to cross the path of contact), 257 nodes: run time of the compiled passage, and its memory (XLA's buffer sizes of
+    the compiled program; the process's peak resident set, compilation included)."""
+    import resource
+    import time
+
+    surf = jg.presets.ground()
+    cases = [
+        ("smooth, thermal", dict(thermal=True), None, True),
+        ("statistical mixed, thermal", dict(mixed="statistical", thermal=True), surf, True),
+        ("deterministic mixed, iso-thermal", dict(mixed="deterministic"), surf, False),
+    ]
+    rows = []
+    path_cases = [(f"{label}, along the path", kw, s, True) for label, kw, s, _ in cases]
+    for rpm in (500.0, 3500.0):
+        for label, kw, s, run_it in cases + path_cases:
+            model = jg.EHLModel(n_nodes=257, **kw)
+            if label.endswith("along the path"):
+                contacts, times, dt = _path_contacts(rpm, model)
+                k = times.shape[0]
+            else:
+                # the pitch-point contact held for as many steps as one engagement takes
+                c = gear_contact(rpm=rpm)
+                _, path_times, dt = _path_contacts(rpm, model)
+                k = path_times.shape[0]
+                contacts = jax.tree_util.tree_map(lambda a, k=k: jnp.full((k,), a), c)
+                times = jnp.arange(k) * dt
+            fn = jax.jit(
+                lambda cs, t, model=model, s=s: solve_ehl_passage(cs, LUB, model, s, times=t)
+            )
+            t0 = time.perf_counter()
+            compiled = fn.lower(contacts, times).compile()
+            t_compile = time.perf_counter() - t0
+            mem = compiled.memory_analysis()
+            arg, out = mem.argument_size_in_bytes, mem.output_size_in_bytes
+            temp = mem.temp_size_in_bytes
+            if run_it:
+                t0 = time.perf_counter()
+                sols = jax.block_until_ready(compiled(contacts, times))
+                t_run = time.perf_counter() - t0
+                conv = int(jnp.sum(sols.converged))
+                # over the converged steps: a failed step reports its (meaningless) values with
+                # converged = False
+                ok = sols.converged
+                loss = float(jnp.sum(jnp.where(ok, sols.power_loss, 0.0)) / jnp.sum(ok)) * 0.02
+                bad = [int(i) for i in jnp.nonzero(~ok)[0]]
+                print(label, rpm, "not converged at steps", bad[:5], "…" if len(bad) > 5 else "")
+                run = f"{t_run:.1f} | {t_run / k * 1e3:.1f} | {conv} of {k} | {loss:.1f}"
+            else:
+                run = "– | – | – | –"
+            peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KiB → MiB
+            rows.append(
+                f"| {label} | {rpm:.0f} | {k} | {t_compile:.0f} | {run} | {_mib(arg):.2f} | "
+                f"{_mib(out):.1f} | {_mib(temp):.1f} | {peak:.0f} |"
+            )
+            print(rows[-1], flush=True)
+    body = "\n".join(
+        [
+            "## One whole engagement, marched, and its memory (`--engagement`, issue 4 Reach)",
+            "",
+            f"Machine: {machine()}. Pitch-point contact, 700 N m, SRR 0.3, ground surfaces, 257 "
+            "nodes, Δt = Δx/ur of the pitch-point contact for the time the contact takes to cross "
+            "the 15.5 mm path of contact (each surface rolls ~5.6 mm through it): the pitch-point "
+            "contact held that long, and the states along the path (quasi-static load sharing of "
+            "the calibrated pair, radii and surface velocities of each position). Memory: what XLA reserves for the compiled passage (arguments, "
+            "outputs: every step's solution, and temporaries), and the process's peak resident set "
+            "since it started (compilation and the earlier rows included, so it only grows down "
+            "the table). Loss: the mean over the converged steps, per contact over the 20 mm face "
+            "width.",
+            "",
+            "| model | rpm | steps | compile, s | run, s | per step, ms | converged | loss, W | "
+            "arguments, MiB | outputs, MiB | temporaries, MiB | peak RSS, MiB |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|",
+            *rows,
+        ]
+    )
+    write_section("mixed_engagement", body)
 
 
 def passage_iterations(k):

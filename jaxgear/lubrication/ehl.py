@@ -783,11 +783,23 @@ def _schedules(model: EHLModel, dtype):
     """Continuation schedules of the piezo-viscous exponent s on the coarsest grid, one row per
     cold attempt: four plateaus 1/4, 1/2, 3/4, 1 first (repeated values cost nothing: Newton stops
     at once when converged), then, if that failed, ``continuation_steps`` equal steps. The third
-    attempt (smooth and statistical films) follows the second schedule up to
-    ``_FINE_CONTINUATION_START`` only and finishes the continuation on the finest grid."""
+    attempt (smooth and statistical films on fine grids) follows the second schedule up to
+    ``_FINE_CONTINUATION_START`` only and finishes the continuation on the finest grid. The last
+    (``_DIRECT_ROW``, smooth and statistical films) has no continuation: s = 1 from the start.
+
+    Why the last: continuation eases the hard, piezo-viscous contacts, but at light load and high
+    speed (thick films, Moes M ≈ 4-7, L ≈ 6.6: the entry and exit of a tooth pair's engagement at
+    3500 rpm) the reduced-exponent problems are the hard ones. There, from the Hertz start at
+    s = 1/4, Newton lets the film offset run away (H0 → 10³ × the Moes film, ‖F‖∞ ≈ 0.2, no
+    solution on that branch) on some domains, while at s = 1 it converges in ~11 iterations on the
+    coarsest grid (measured 2026-11-26: M = 4.2 on −7 … 1.5 half-widths)."""
     k = model.continuation_steps
     i = np.arange(1, k + 1)
-    return jnp.asarray(np.stack([np.ceil(4.0 * i / k) / 4.0, i / k, i / k]), dtype=dtype)
+    rows = [np.ceil(4.0 * i / k) / 4.0, i / k, i / k, np.ones(k)]
+    return jnp.asarray(np.stack(rows), dtype=dtype)
+
+
+_DIRECT_ROW = 3  # the schedule row without continuation (see ``_schedules``)
 
 
 # exponent s at which the third cold attempt reaches the finest grid. Measured (Barus,
@@ -875,15 +887,16 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     (the warm start, then, only if that failed, the cold start), so compile time does not double."""
     sc, fine = _fine_level(model, inp)
     dtype = fine.x.dtype
-    schedules = _schedules(model, dtype)
-    # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule; each runs
-    # only if everything before it failed (lax.cond: no work when skipped, outside vmap). The third
-    # attempt only on fine grids, where the one-cell spike trap arises (under vmap a skipped attempt
-    # still runs, so coarser grids do not pay for it); deterministic mixed films continue in the
-    # roughness instead, and stop after a failed continuation that got under way
+    # attempts: [warm start,] cold with the fine schedule, cold with the coarse schedule, [cold
+    # finishing the continuation on the finest grid,] cold without continuation; each runs only if
+    # everything before it failed (lax.cond: no work when skipped, outside vmap). The fine-grid
+    # continuation only on fine grids, where the one-cell spike trap arises (under vmap a skipped
+    # attempt still runs, so coarser grids do not pay for it); deterministic mixed films continue
+    # in the roughness from a smooth film instead (the first two rows), and stop after a failed
+    # continuation that got under way
     third = mixed != "deterministic" and model.n_nodes >= _FINE_CONTINUATION_NODES
-    n_cold = schedules.shape[0] - (0 if third else 1)
-    kinds = jnp.asarray(([0] if warm else []) + list(range(1, n_cold + 1)))
+    rows = [0, 1] + ([2] if third else []) + ([_DIRECT_ROW] if mixed != "deterministic" else [])
+    kinds = jnp.asarray(([0] if warm else []) + [r + 1 for r in rows])
     u_warm = _warm_start(fine, init_x, init_p, init_h0) if warm else _hertz_start(fine)
     false = jnp.asarray(False)
 
@@ -893,7 +906,7 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
         # The branches read only their operand (no batched value closed over): cond_any_member.
         def cold(operand):
             kind, _, inp = operand
-            row = jnp.clip(kind - 1, 0, n_cold - 1)
+            row = jnp.clip(kind - 1, 0, _DIRECT_ROW)
             # the coarse grids are built here, inside the branch: a warm start never pays for them
             _, levels = _levels(model, inp)
             fine = levels[-1]
