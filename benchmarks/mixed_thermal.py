@@ -177,8 +177,9 @@ def _path_contacts(rpm, model):
 
 def engagement():
     """One engagement marched step by step (Δt = Δx/ur of the pitch-point contact, for the time
-    the contact takes to cross the path of contact), 257 nodes: run time of the compiled passage, and its memory (XLA's buffer sizes of
-    the compiled program; the process's peak resident set, compilation included)."""
+    the contact takes to cross the path of contact), 257 nodes: run time of the compiled passage,
+    and its memory (XLA's buffer sizes of the compiled program; the process's peak resident set,
+    compilation included)."""
     import resource
     import time
 
@@ -240,7 +241,8 @@ def engagement():
             "nodes, Δt = Δx/ur of the pitch-point contact for the time the contact takes to cross "
             "the 15.5 mm path of contact (each surface rolls ~5.6 mm through it): the pitch-point "
             "contact held that long, and the states along the path (quasi-static load sharing of "
-            "the calibrated pair, radii and surface velocities of each position). Memory: what XLA reserves for the compiled passage (arguments, "
+            "the calibrated pair, radii and surface velocities of each position). Memory: what "
+            "XLA reserves for the compiled passage (arguments, "
             "outputs: every step's solution, and temporaries), and the process's peak resident set "
             "since it started (compilation and the earlier rows included, so it only grows down "
             "the table). Loss: the mean over the converged steps, per contact over the 20 mm face "
