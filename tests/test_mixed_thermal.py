@@ -137,6 +137,30 @@ def test_thermal_friction_below_isothermal_at_high_sliding_equal_without():
     np.testing.assert_allclose(hot0.h_central, cold0.h_central, rtol=1e-2)
 
 
+def _assert_heat_balance(sol, c):
+    """Energy balance of a converged thermal state: the heat generated (paper Eq. 12) leaves by
+    conduction into both solids and by convection with the film (REFERENCE §5); and the solution's
+    surface temperatures are those of its own heat source (Picard converged: within 1 % of the
+    rise)."""
+    temps = jg.thermal.solve_contact_temperatures(
+        sol.x,
+        sol.heat_flux,
+        jnp.maximum(sol.h, 0.0),
+        c.u1,
+        c.u2,
+        steel(),
+        steel(),
+        sol.density,
+        LUB.specific_heat,
+        LUB.thermal_conductivity,
+    )
+    generated = float(jnp.sum(sol.heat_flux))
+    removed = float(jnp.sum(temps.flux1 + temps.flux2 + temps.convected))
+    assert abs(removed - generated) <= 1e-9 * abs(generated)
+    rise1 = np.asarray(sol.surface_temperature1 - c.inlet_temperature)
+    np.testing.assert_allclose(rise1, temps.surface1, atol=0.01 * rise1.max())
+
+
 def test_temperature_rise_grows_with_speed_and_heat_is_conserved():
     rises = []
     for rpm in (1000.0, 3500.0):
@@ -144,28 +168,52 @@ def test_temperature_rise_grows_with_speed_and_heat_is_conserved():
         sol = jg.solve_ehl(c, LUB, STAT_THERMAL, ground())
         assert bool(sol.converged)
         rises.append(float(sol.temperature.max() - c.inlet_temperature))
-        # energy balance of the converged thermal state: the heat generated (paper Eq. 12) leaves
-        # by conduction into both solids and by convection with the film (REFERENCE §5)
-        temps = jg.thermal.solve_contact_temperatures(
-            sol.x,
-            sol.heat_flux,
-            jnp.maximum(sol.h, 0.0),
-            c.u1,
-            c.u2,
-            steel(),
-            steel(),
-            sol.density,
-            LUB.specific_heat,
-            LUB.thermal_conductivity,
-        )
-        generated = float(jnp.sum(sol.heat_flux))
-        removed = float(jnp.sum(temps.flux1 + temps.flux2 + temps.convected))
-        assert abs(removed - generated) <= 1e-9 * abs(generated)
-        # and the solution's surface temperatures are those of its own heat source (Picard
-        # converged: within 1 % of the rise)
-        rise1 = np.asarray(sol.surface_temperature1 - c.inlet_temperature)
-        np.testing.assert_allclose(rise1, temps.surface1, atol=0.01 * rise1.max())
+        _assert_heat_balance(sol, c)
     assert rises[1] > rises[0] > 0.0
+
+
+def test_thermal_deterministic_full_ground_settles_by_relaxed_temperature_updates():
+    # The paper's ground surfaces at full roughness in the film, speed E, 257 nodes, thermal. With
+    # the unrelaxed update the temperatures swung between films ~150 and ~740 K hot (the
+    # deterministic film's Poiseuille heat falls as its viscosity does) and after 16 updates
+    # still moved by 250 K (measured before the Aitken relaxation; the solve was reported as not
+    # converged). Relaxed, they settle in 14 updates, to a film ~180 K hot: the known excess of
+    # the deterministic Poiseuille heat (README, known open points), not a solver failure.
+    c = gear_contact(rpm=3500.0)
+    model = jg.EHLModel(n_nodes=257, mixed="deterministic", thermal=True)
+    sol = jg.solve_ehl(c, LUB, model, ground())
+    assert bool(sol.converged), (float(sol.residual), float(sol.thermal_residual))
+    rise = float(sol.temperature.max() - c.inlet_temperature)
+    assert rise > 10.0
+    assert float(sol.thermal_residual) <= 0.01 * rise
+    assert float(sol.contact_load_share) > 0.01  # still mixed: asperities carry load
+    _assert_heat_balance(sol, c)
+
+
+def test_aitken_relaxation_settles_an_oscillating_update_and_leaves_a_monotone_one_alone():
+    # the temperature update's relaxation (ehl._aitken) on linear maps g(x) = a x + c, whose fixed
+    # point is c/(1 − a): for a = −1.5 the plain iteration diverges (|a| > 1); Aitken's secant ω is
+    # exact for a linear map from its second update on
+    from jaxgear.lubrication.ehl import _aitken
+
+    c = jnp.linspace(1.0, 2.0, 5)
+    for a, updates in ((-1.5, 3), (-0.9, 3)):
+        x = jnp.zeros(5)
+        state = (jnp.ones(()), jnp.zeros(5), jnp.asarray(False))
+        for _ in range(updates):
+            x, state = _aitken(x, a * x + c, state)
+        np.testing.assert_allclose(x, c / (1.0 - a), rtol=1e-12)
+        assert 0.0 < float(state[0]) < 1.0
+    # a contracting monotone map (a = 0.5): Aitken would over-relax (ω = 2); it stays at 1, so
+    # the smooth and statistical films' usual updates are unchanged
+    x = jnp.zeros(5)
+    state = (jnp.ones(()), jnp.zeros(5), jnp.asarray(False))
+    plain = jnp.zeros(5)
+    for _ in range(4):
+        x, state = _aitken(x, 0.5 * x + c, state)
+        plain = 0.5 * plain + c
+        assert float(state[0]) == 1.0
+    np.testing.assert_allclose(x, plain, rtol=1e-15)
 
 
 # --------------------------------------------------------------------------------------------------
