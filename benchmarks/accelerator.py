@@ -118,7 +118,15 @@ def main(argv=None):
         help="comma-separated sweep modes to time, in this order",
     )
     ap.add_argument("--compare", help="JSON from another backend's run: Φ̄ differences")
-    ap.add_argument("--speeds", type=int, default=len(SPEEDS), help="first N baseline speeds")
+    ap.add_argument("--speeds", type=int, default=None, help="first N baseline speeds")
+    ap.add_argument("--step", type=float, default=25.0, help="speed step of the sweep, rpm")
+    ap.add_argument(
+        "--exclude-rpm",
+        nargs="+",
+        default=[],
+        metavar="LO:HI",
+        help="leave out the speeds in these ranges (rpm, inclusive), e.g. the attractor bands",
+    )
     ap.add_argument("--section", action="store_true", help="write the RESULTS.md section")
     ap.add_argument("--note", default="", help="a paragraph appended to the section")
     ap.add_argument(
@@ -138,7 +146,10 @@ def main(argv=None):
         if args.section:
             write_section("accelerator", text)
         return
-    speeds = SPEEDS[: args.speeds]
+    speeds = np.arange(500.0, 4200.0 + 1e-9, args.step)[: args.speeds]
+    for band in args.exclude_rpm:
+        lo, hi = (float(v) for v in band.split(":"))
+        speeds = speeds[(speeds < lo) | (speeds > hi)]
     dev = jax.devices()[0]
     print("backend", jax.default_backend(), dev.device_kind, flush=True)
 
