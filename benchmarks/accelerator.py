@@ -33,7 +33,6 @@ import jaxgear as jg  # noqa: E402
 
 PAIR = jg.presets.li2015_pair_calibrated()
 LUB, SURF = jg.presets.mil_l_23699(), jg.presets.ground()
-SPEEDS = np.arange(500.0, 4200.0 + 1e-9, 25.0)
 
 
 def _op(rpm):
