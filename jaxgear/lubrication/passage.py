@@ -64,6 +64,7 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
     prev, temp1, temp2, d, t_prev, u_prev = carry
     dt = jnp.maximum(t - t_prev, 1e-300)
     u_now = jnp.stack([contact.u1, contact.u2])
+    d_prev = d
     d = d + 0.5 * (u_prev + u_now) * (t - t_prev)
     x = _grid_positions(model, contact, lubricant)
     dx = x[1] - x[0]
@@ -97,6 +98,8 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         rise,
         seed,
         sigma,
+        # where the roughness stood at the previous step: a deterministic step's start generator
+        _roughness_offset(mixed, surfaces, x, d_prev) if mixed == "deterministic" else None,
     )
     transient = None
     if model.thermal:
@@ -112,7 +115,8 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
             model, False, mixed, inp, x[:2], x[:2], jnp.zeros(()), solids, transient
         )
     else:
-        sol, temps = _solve_impl(model, True, mixed, inp, *_warm_args(prev), solids, transient)
+        args = _warm_args(prev, mixed == "deterministic", moved=True)
+        sol, temps = _solve_impl(model, True, mixed, inp, *args, solids, transient)
     if model.thermal:
         temp1 = thermal_mod.transient_update(
             frees[0][0], frees[0][1], temps.flux1, depth
