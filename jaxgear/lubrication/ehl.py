@@ -944,46 +944,29 @@ _RELAX_LOAD_GAIN = 0.02  # film-offset change per sweep, × the load error × th
 _RELAX_ROUNDS = 3
 _RETRY = -1  # attempt kind: a further relaxation round from where the last Newton stopped
 _HALF = -2  # attempt kind: this step's start from the solution of its half step
-_HALF_ROUNDS = 1  # relaxed rounds of the half step
 # the later rounds and the half step are tried only if the last Newton ended with ‖F‖∞ below this.
 # Measured (residual after the first round → what the later attempts gave): at 500 rpm, of 29 steps
 # ending at ≥ 0.1, 5 were rescued, of 33 ending below it, 17; at 3500 rpm 3 of 12 and 13 of 16
 _RELAX_GIVE_UP = 0.1
 
 
-def _relaxed_rounds(model: EHLModel, level: _Level, u, rounds: int = _RELAX_ROUNDS):
-    """Relaxation and Newton in ``rounds`` rounds (``_distributive_relaxation``) on ``level`` from
-    ``u``: (u, converged, Newton iterations)."""
-    first = model.relaxation_sweeps
-
-    def cond(state):
-        _, ok, _, n = state
-        return (~ok) & (n < rounds)
-
-    def body(state):
-        u, _, k, n = state
-        u = _distributive_relaxation(level, u, jnp.where(n == 0, first, max(first // 2, 1)))
-        u, _, k_new, ok = _newton(level, u, 1.0, model.warm_iterations)
-        return u, ok, k + k_new, n + 1
-
-    init = (u, jnp.asarray(False), jnp.asarray(0), jnp.asarray(0))
-    u, ok, k, _ = jax.lax.while_loop(cond, body, init)
-    return u, ok, k
-
-
 def _half_step_start(model: EHLModel, inp: _Inputs, u_start):
     """A start for a transient deterministic step whose relaxed warm starts failed: the half step
-    (each surface displaced half as far, Δt/2) solved by relaxed rounds from ``u_start``, its
-    pressure averaged over 5 cells and relaxed on this step's system. Only the start changes, not
-    the problem solved. Measured over 152 steps along the path at 3500 rpm (257 nodes): of the 19
-    whose three relaxed rounds failed, the half step converged for 16 and this step then for 12;
-    at 500 rpm, of 52, for 27 and 20. Returns (start, Newton iterations)."""
+    (each surface displaced half as far, Δt/2) solved from ``u_start`` by one relaxation and Newton
+    round, its pressure averaged over 5 cells and relaxed on this step's system. Only the start
+    changes, not the problem solved. Measured over 152 steps along the path at 3500 rpm (257
+    nodes), the half step solved in three rounds: of the 19 steps whose three relaxed rounds
+    failed, the half step converged for 16 and this step then for 12; at 500 rpm, of 52, for 27
+    and 20. One round, kept since it costs less: one engagement 77 against 75 s at 3500 rpm, 167
+    against 183 s at 500 rpm. Returns (start, Newton iterations)."""
     half = eqx.tree_at(
         lambda i: (i.film_offset, i.inv_time_step),
         inp,
         (0.5 * (inp.film_offset + inp.film_offset_previous), 2.0 * inp.inv_time_step),
     )
-    u_half, ok, k = _relaxed_rounds(model, _fine_level(model, half)[1], u_start, _HALF_ROUNDS)
+    level = _fine_level(model, half)[1]
+    u_half = _distributive_relaxation(level, u_start, model.relaxation_sweeps)
+    u_half, _, k, ok = _newton(level, u_half, 1.0, model.warm_iterations)
     fine = _fine_level(model, inp)[1]
     n = fine.n
     start = jnp.concatenate([_box_average(u_half[:n]), u_half[n:]])
