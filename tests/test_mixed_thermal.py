@@ -121,6 +121,62 @@ def test_deterministic_transient_step_is_reached_from_the_previous_step_by_relax
     assert abs(float(relaxed.h0 - cold.h0)) < 1e-6 * float(relaxed.h_central)
 
 
+def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_steady_film():
+    # A transient step that falls back to the cold solve continues from the smooth steady film in
+    # r, which scales the roughness and blends the squeeze term's previous film from the smooth
+    # film's ρ̄H (r = 0) to the previous step's rough one (r = 1). At r = 0 the smooth steady
+    # solution must then solve the system (its squeeze term vanishes there), and at r = 1 the
+    # system must be the step's own. The roughness-only continuation it replaced kept the rough
+    # previous film at r = 0: at the smooth solution its residual is O(1) (measured ‖F‖∞ = 17,
+    # against 1e-14 for the blend), and 26 of 212 cold solves along the path at 3500 rpm failed
+    # their first roughness step.
+    from jaxgear.lubrication import ehl
+
+    c = gear_contact(rpm=3500.0)
+    dt = float(grid_time_step(c, LUB, DET))
+    surf = ground()
+    steady = jg.solve_ehl(c, LUB, DET, surf, displacement=jnp.zeros(2))
+    assert bool(steady.converged)
+    # the next step's inputs, as solve_ehl builds them
+    x = ehl._grid_positions(DET, c, LUB)
+    d = np.asarray([float(c.u1), float(c.u2)]) * dt
+    offset = -(surf.displaced_height(0, x, d[0]) + surf.displaced_height(1, x, d[1]))
+    zero = jnp.zeros_like(x)
+    inp = ehl._Inputs(
+        c,
+        LUB,
+        jnp.interp(x, steady.x, steady.rho_h),
+        1.0 / dt,
+        offset,
+        zero,
+        zero,
+        surf.composite_rq,
+    )
+    _, levels = ehl._levels(DET, inp)
+    fine = levels[-1]
+    smooth = [lev.smooth_steady() for lev in levels]
+    start, _ = ehl._cold_start(DET, smooth, ehl._schedules(DET, x.dtype)[0], cubic=True)
+    u_s, res, _, ok = ehl._newton(smooth[-1], start, 1.0, DET.max_iterations)
+    assert bool(ok), float(res)
+    system = ehl._rough_homotopy(fine, smooth[-1].rho_h(u_s))
+    at_zero, s = system(0.0)
+    assert s == 1.0
+    # r = 0: solved by the smooth steady film (to its Newton tolerance, 1e-9)
+    assert float(jnp.max(jnp.abs(at_zero.residual(u_s)))) < 10.0 * DET.tolerance
+    # the roughness-only continuation's r = 0 is not
+    assert float(jnp.max(jnp.abs(fine.with_roughness(0.0).residual(u_s)))) > 0.1
+    # r = 1: the step's own system (the blend reproduces the previous film to rounding)
+    at_one, _ = system(1.0)
+    u = jnp.concatenate(
+        [
+            jnp.interp(fine.x, steady.x / steady.hertz_half_width, steady.p)
+            / steady.hertz_pressure,
+            jnp.asarray([u_s[-1]]),
+        ]
+    )
+    np.testing.assert_allclose(at_one.residual(u), fine.residual(u), rtol=1e-10, atol=1e-12)
+
+
 def test_statistical_ground_vs_polished_regimes():
     # REFERENCE §6: λ ≈ 0.1-0.4 ground (deep mixed), 0.8-3.4 polished. R10: polished at speed E is
     # full film with p well below 2 GPa.
