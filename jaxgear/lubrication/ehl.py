@@ -858,7 +858,8 @@ def _schedules(model: EHLModel, dtype):
     at once when converged), then, if that failed, ``continuation_steps`` equal steps. The third
     attempt (smooth and statistical films on fine grids) follows the second schedule up to
     ``_FINE_CONTINUATION_START`` only and finishes the continuation on the finest grid. The last
-    (``_DIRECT_ROW``, smooth and statistical films) has no continuation: s = 1 from the start.
+    (``_DIRECT_ROW``; for a deterministic rough film, its smooth start) has no continuation: s = 1
+    from the start.
 
     Why the last: continuation eases the hard, piezo-viscous contacts, but at light load and high
     speed (thick films, Moes M ≈ 4-7, L ≈ 6.6: the entry and exit of a tooth pair's engagement at
@@ -1094,10 +1095,10 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     # everything before it failed (lax.cond: no work when skipped, outside vmap). The fine-grid
     # continuation only on fine grids, where the one-cell spike trap arises (under vmap a skipped
     # attempt still runs, so coarser grids do not pay for it); deterministic mixed films continue
-    # in the roughness from a smooth film instead (the first two rows), and stop after a failed
-    # continuation that got under way
+    # in the roughness from a smooth film instead (its start from the first, second or last row),
+    # and stop after a failed continuation that got under way
     third = mixed != "deterministic" and model.n_nodes >= _FINE_CONTINUATION_NODES
-    rows = [0, 1] + ([2] if third else []) + ([_DIRECT_ROW] if mixed != "deterministic" else [])
+    rows = [0, 1] + ([2] if third else []) + [_DIRECT_ROW]
     det = mixed == "deterministic"
     u_start = _warm_start(fine, init_x, init_p, init_h0, det) if warm else _hertz_start(fine)
     # deterministic roughness: relaxation sweeps before the warm Newton; if it fails, more sweeps
