@@ -1153,9 +1153,9 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
                 return start, k0, false
             # mixed: the smooth steady problem first, then a continuation on the fine grid (coarse
             # grids cannot resolve the roughness anyway) in r, which scales the roughness and, in a
-            # transient step, moves the squeeze term's previous film from the smooth film's ρ̄H
-            # (at r = 0 the smooth steady solution solves the system) to the previous step's rough
-            # one (see ``_rough_homotopy``)
+            # transient step, moves the squeeze term's previous film from the smooth start's ρ̄H
+            # (at r = 0 the system is the smooth steady one, its squeeze term vanishing at that
+            # start) to the previous step's rough one (see ``_rough_homotopy``)
             smooth = [lev.smooth_steady() for lev in levels]
             start, k0 = _cold_start(model, smooth, schedules[row], cubic=row == 0)
             start, k0, reached = _adaptive_continuation(
@@ -1228,17 +1228,18 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
 
 def _rough_homotopy(fine: _Level, rho_h_smooth):
     """r ↦ (the system at r, s = 1) of a deterministic rough film's cold solve: the roughness
-    scaled by r and the previous step's ρ̄H blended from ``rho_h_smooth`` (the smooth steady
-    film's, r = 0) to the step's own (r = 1), so that both perturbations of the smooth steady
-    solution grow with r (a steady solve has no squeeze term: only the roughness moves).
+    scaled by r and the previous step's ρ̄H blended from ``rho_h_smooth`` (r = 0: the smooth steady
+    film's, as the cold start gives it on the fine grid) to the step's own (r = 1), so that both
+    perturbations of the smooth steady solution grow with r (a steady solve has no squeeze term:
+    only the roughness moves).
 
     Why: a transient step that falls back to the cold solve used to continue in the roughness alone,
     with the squeeze term pulling the film towards the previous step's rough ρ̄H from r = 0 on: at
     small r a smooth gap against a rough previous film, an O(1) inconsistency from the first step.
     Measured on one engagement along the path (257 nodes, ground, 900 steps; old and new code in
-    the same hour): at 3500 rpm 26 of 212 such cold solves failed their first roughness step and
-    16 steps failed in all; now 2 of 201 and 2 steps, 39.5 against 56.0 s; at 500 rpm 28 of 506
-    and 43 steps, now 0 of 486 and 5 steps, 91 against 97 s. Scaling the squeeze term by r instead
+    the same hour, a one-off script logging each attempt): at 3500 rpm 26 of 212 such cold solves
+    failed their first roughness step and 16 steps failed in all; now 2 of 201 and 2 steps, 39.5
+    against 56.0 s; at 500 rpm 28 of 506 and 43 steps, now 0 of 486 and 5 steps, 91 against 97 s. Scaling the squeeze term by r instead
     (steady at r = 0) also converges them (896 and 875 of 900 steps) but needs longer continuations
     at 500 rpm (median 202 against 127 Newton iterations)."""
 
@@ -1260,8 +1261,8 @@ def _adaptive_continuation(model: EHLModel, system_at, u, k0, r0, steps: int):
 
     Used for the roughness amplitude (deterministic mixed film, from the smooth solution;
     ``steps`` = ``roughness_steps``) and for the piezo-viscous exponent (third cold attempt of a
-    smooth film; ``_EXPONENT_STEPS``). Steps start at 1/``steps``; each starts from the secant extrapolation of the last two accepted
-    states; a step whose Newton solve fails within half the model's iteration budget is retried at
+    smooth film; ``_EXPONENT_STEPS``). Steps start at 1/``steps``; each starts from the secant
+    extrapolation of the last two accepted states; a step whose Newton solve fails within half the model's iteration budget is retried at
     half the increment (down to 1/256 of the first), an accepted one lets the next grow by a third.
     Measured at the paper's pitch contact (700 N m, 3500 rpm, ground, λ ≈ 0.4): four fixed roughness
     steps failed beyond 0.8 of the roughness at 257 nodes and beyond 0.3 at 1025 nodes (residual
