@@ -71,10 +71,10 @@ FIELD_ROLL_ANGLE_DEG = {7: 25.0, 12: 17.0}
 #: correlation length of ``presets.ground()``. Finer is not yet reliable: at 1025 nodes the
 #: roughness continuation of that contact stalls at 0.97 of the roughness (residual 2e-2), while at
 #: the pitch contact 513 and 1025 nodes give the same p_max (6.64 GPa). Steady and iso-thermal: the
-#: thermal deterministic solve settles at the paper's ground roughness on 257 nodes only (at speed
-#: E, to a film ~180 K hot: the deterministic Poiseuille heat's excess), while on 513 nodes its
-#: Reynolds solves at the 300-700 K hotter films of the first temperature updates fail; and the
-#: roughness is frozen at the instant (moving roughness: ``solve_ehl_passage``).
+#: thermal deterministic solve settles at the paper's ground roughness on 257 and 513 nodes (at
+#: speed E, to films 181 and 348 K hot at their hottest node: the deterministic Poiseuille heat's
+#: excess) but not on 1025; and the roughness is frozen at the instant (moving roughness:
+#: ``solve_ehl_passage``).
 FIELD_DETERMINISTIC_NODES = 513
 
 BASELINE_INLET_C, VARIANT_INLET_C = 90.0, 60.0
