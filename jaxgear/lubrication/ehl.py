@@ -1701,6 +1701,8 @@ def solve_ehl(
             lubrication with the roughness S1 + S2 in the film (paper Eq. 5), asperity contact
             where the film closes (Hu-Zhu unified Reynolds, paper Eq. 4b/4c) and boundary friction
             μb p there. The grid must resolve the roughness (Δx ≲ 1-3 µm).
+            A deep mixed steady film whose solve does not converge (500 rpm, ground, 513 nodes
+            and finer): ``jaxgear.lubrication.passage.settle_rough_film``.
         initial: a previous EHLSolution to warm-start from (any contact; its p(x) is interpolated
             and its h0 reused). A failed warm start falls back to a cold solve.
         previous: the solution at the previous time step; with ``time_step`` Δt (s) the squeeze term
