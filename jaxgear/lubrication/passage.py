@@ -261,7 +261,10 @@ def settle_rough_film(
     whose pressure the neighbouring fluid node's flow coefficient sets), while the transient steps,
     whose squeeze term couples each node's film to its own previous value, converge. Measured
     (2026-11-27, pitch contact, 700 N m, SRR 0.3): 33 pseudo-time steps at Δt of 1-8 Δx/ur, then
-    the steady solve in 12 iterations: p_max 5.9 ph, 5.9 % of the load on asperities; ~2 min.
+    the steady solve in 12 iterations: p_max 5.9 ph, 5.9 % of the load on asperities; ~2 min; on
+    1025 nodes it converges as well (3 min). Three more cases on 513 nodes whose direct solve fails
+    (residual 0.10-0.20) settle: 500 rpm at SRR 0.6 (104 s), 500 rpm at 1500 N m (19 s) and
+    1000 rpm (34 s).
 
     Eager: a Python loop of compiled solves (not for use under ``jit`` or ``vmap``).
 
