@@ -252,8 +252,8 @@ def settle_rough_film(
     (:func:`grid_time_step`), the step doubled after each converged step and halved after a failed
     one (which is discarded). Once a step changes the pressure by less than ``SETTLE_CHANGE`` × ph,
     the steady solve is tried from that state; its result is returned when it converges. The answer
-    is always a steady solution (``converged``); the march only supplies its start, so the solution
-    and its implicit gradients are those of the steady problem.
+    is always a solution of the steady problem (``converged``): the march only supplies its start.
+    The function itself is eager and so not differentiable (traced inputs are rejected).
 
     Why: in deep mixed films (the paper's ground surfaces at 500 rpm, λ ≈ 0.1) the continuation in
     the roughness amplitude of the direct solve meets a fold of the discrete branch on 513 nodes
