@@ -180,10 +180,11 @@ class EHLModel(eqx.Module):
             (paper Eq. 5) with the unified Reynolds equation (Hu-Zhu); needs Δx ≲ 2 µm. A cold
             solve continues adaptively in the roughness amplitude from the smooth film. Measured
             with ``presets.ground()`` at the paper's pitch contact: converges at 3500 rpm
-            (λ ≈ 0.4) on 257-1025 nodes; at 500 rpm (λ ≈ 0.1) on 257 nodes but not on 1025, where
-            the continuation stalls at 0.43 of the roughness (reported as not converged). A
-            continuation that accepted at least one step and then failed is not repeated by a
-            second cold attempt (it would start from the same smooth film and take the same path).
+            (λ ≈ 0.4) on 257-1025 nodes; at 500 rpm (λ ≈ 0.1) on 257 nodes, while on 513 and 1025
+            nodes the continuation stalls (at 0.775 and 0.43 of the roughness) and the film is
+            reached by the pseudo-time march (``pseudo_transient_steps``). A continuation that
+            accepted at least one step and then failed is not repeated by a second cold attempt
+            (it would start from the same smooth film and take the same path).
             "statistical": the mean film with the Greenwood-Tripp asperity pressure p_a(h)
             (``asperity.py``) added to the load and the deformation (Johnson-Greenwood-Poon load
             sharing), iterated with the temperatures; robust down to λ → 0; it needs only the
@@ -203,6 +204,14 @@ class EHLModel(eqx.Module):
             from the plain warm start, which then nearly always falls back to the cold solve.
             Measured over one engagement along the path (900 steps, 257 nodes), against 0 in the
             same hour: 108 against 172 s at 3500 rpm, 150 against 172 s at 500 rpm.
+        pseudo_transient_steps: the last attempt of a deterministic rough film whose other
+            attempts failed: pseudo-transient continuation (``_pseudo_march``), at most this many
+            pseudo-time steps (each a continuation in the roughness from the smooth film with a
+            squeeze term towards the last state, Δτ doubling from Δx/ur), then the steady problem
+            from where the march settled. 0: no such attempt. The steps of a transient passage
+            (``solve_ehl_passage``) never take it. Measured at 500 rpm, pitch contact, ground,
+            where the direct solve fails: 700 N m on 513 nodes 34 s, on 1025 nodes 103 s, 1500 N m
+            on 513 nodes 22 s after compilation; a deterministic solve compiles ~1.5 s longer.
     """
 
     n_nodes: int = eqx.field(static=True, default=257)
@@ -231,6 +240,7 @@ class EHLModel(eqx.Module):
     asperity_relaxation: float = eqx.field(static=True, default=0.5)
     limiting_shear_coefficient: float | None = eqx.field(static=True, default=None)
     relaxation_sweeps: int = eqx.field(static=True, default=100)
+    pseudo_transient_steps: int = eqx.field(static=True, default=64)
 
     def __check_init__(self):
         if not isinstance(self.n_nodes, int) or self.n_nodes < 17:
@@ -269,6 +279,7 @@ class EHLModel(eqx.Module):
         # the coarsest grid of the sequence (a larger value than n_nodes means a single grid)
         check_integer("EHLModel.coarsest_nodes", self.coarsest_nodes, 17)
         check_integer("EHLModel.relaxation_sweeps", self.relaxation_sweeps, 0)
+        check_integer("EHLModel.pseudo_transient_steps", self.pseudo_transient_steps, 0)
         check_range("EHLModel.boundary_friction", self.boundary_friction, 0.0, 1.0)
         check_range(
             "EHLModel.contact_threshold", self.contact_threshold, 1e-4, 0.1, low_inclusive=True
@@ -1119,7 +1130,9 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     # as far), its solution, relaxed, this step's start
     half = relax and inp.film_offset_previous is not None
     warm_kinds = ([0] + rounds + ([_HALF] if half else [])) if warm else []
-    kinds = jnp.asarray(warm_kinds + [r + 1 for r in rows])
+    # deterministic roughness, when everything else failed: the pseudo-time march
+    pseudo = det and model.pseudo_transient_steps > 0
+    kinds = jnp.asarray(warm_kinds + [r + 1 for r in rows] + ([_PSEUDO] if pseudo else []))
     false = jnp.asarray(False)
 
     def attempt(carry, kind):
@@ -1158,14 +1171,30 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
             # start) to the previous step's rough one (see ``_rough_homotopy``)
             smooth = [lev.smooth_steady() for lev in levels]
             start, k0 = _cold_start(model, smooth, schedules[row], cubic=row == 0)
+            rho_h_smooth = smooth[-1].rho_h(start)
+            smooth_start = start
+            path = fine
+            if pseudo:
+                # the pseudo-time attempt's first step (Δt = Δx/ur from the smooth film) is this
+                # continuation with the pseudo squeeze term added; its other kinds add none
+                sigma = jnp.where(kind == _PSEUDO, 1.0 / fine.spacing, 0.0)
+                path = _with_pseudo_squeeze(fine, sigma, rho_h_smooth)
             start, k0, reached = _adaptive_continuation(
                 model,
-                _rough_homotopy(fine, smooth[-1].rho_h(start)),
+                _rough_homotopy(path, rho_h_smooth),
                 start,
                 k0,
                 jnp.zeros((), dtype),
                 model.roughness_steps,
             )
+            if pseudo:
+                # a first pseudo-time step that failed leaves nothing to march from
+                go = (kind == _PSEUDO) & (reached >= 1.0)
+                steps = jnp.where(go, model.pseudo_transient_steps, 0)
+                start, k_march = _pseudo_march(
+                    model, fine, start, smooth_start, rho_h_smooth, steps
+                )
+                k0 = k0 + k_march
             # once a roughness step has been accepted, the smooth start was good: if this attempt
             # fails, the next would repeat the same continuation from the same smooth film
             # (measured: a more patient continuation, 16 first steps and twice the Newton budget,
@@ -1196,7 +1225,8 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
 
         # further relaxed rounds only after a Newton that got close (see ``_RELAX_GIVE_UP``)
         hopeless = ((kind == _RETRY) | (kind == _HALF)) & ~(res < _RELAX_GIVE_UP)
-        done = ok | stop | hopeless
+        # a failed roughness continuation ends the cold attempts, not the pseudo-time march
+        done = ok | (stop & (kind != _PSEUDO)) | hopeless
         operand = (kind, u, inp, u_start)
         start, k0, repeat = cond_any_member(done | (kind == 0), keep, prepare, operand)
         start = jnp.where(kind == 0, u_warm, start)
@@ -1224,6 +1254,91 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
     res = jnp.where(finite & jnp.isfinite(res), res, jnp.finfo(u.dtype).max)
     ok = ok & finite
     return u, res, it.astype(u.dtype), ok.astype(u.dtype)
+
+
+_PSEUDO = -3  # attempt kind: the pseudo-time march (deterministic roughness, after the cold ones)
+
+#: the largest pressure change of an accepted pseudo-time step (× ph) below which the march tries
+#: the steady problem from its state. Measured at the case it was built for (500 rpm, pitch
+#: contact, ground, 513 nodes, 2026-11-27): the steady solve failed from states whose last step
+#: changed the pressure by 0.12-0.16 ph and converged, in 12 iterations, from one at 0.11 ph.
+SETTLE_CHANGE = 0.12
+_PSEUDO_SMALLEST = 2.0**-10  # the shortest pseudo-time step, × Δx/ur
+
+
+def _with_pseudo_squeeze(level: _Level, sigma, rho_h_state):
+    """The level with a pseudo-time squeeze term σp (ρ̄H − ρ̄H_state) added to its own (backward
+    Euler in pseudo-time, σp = b/(um Δτ)). The squeeze term is linear in ρ̄H, so the sum is one
+    squeeze term: σ' = σ + σp, ρ̄H'_prev = ρ̄H_prev + σp/σ' (ρ̄H_state − ρ̄H_prev). σp = 0 gives the
+    level itself (to the bit)."""
+    total = level.sc.squeeze + sigma
+    weight = jnp.where(sigma > 0.0, sigma / jnp.where(sigma > 0.0, total, 1.0), 0.0)
+    prev = level.rho_h_prev + weight * (rho_h_state - level.rho_h_prev)
+    return eqx.tree_at(lambda lev: (lev.sc.squeeze, lev.rho_h_prev), level, (total, prev))
+
+
+def _pseudo_march(model: EHLModel, fine: _Level, u, u_smooth, rho_h_smooth, steps):
+    """Pseudo-transient continuation of a deterministic rough film whose direct solves failed.
+
+    ``u`` is the first pseudo-time step's solution (Δτ = Δx/ur from the smooth film, see
+    ``_solve_core``). Each further step solves ``fine``'s problem plus a pseudo-time squeeze term
+    σp (ρ̄H − ρ̄H of the last accepted state) (``_with_pseudo_squeeze``, backward Euler with the
+    roughness held) by the cold path: the continuation in the roughness amplitude from the smooth
+    film ``u_smooth`` (``_rough_homotopy``: the squeeze term's reference blended from the smooth
+    film's ρ̄H with the roughness). Δτ starts at 2 Δx/ur, doubles after a converged step and halves
+    after a failed one (discarded), down to ``_PSEUDO_SMALLEST``. After a step that changed P by
+    less than ``SETTLE_CHANGE``, Newton on ``fine``'s own problem from that state; the march stops
+    when it converges. At most ``steps`` steps. Returns (the last state, iterations): the caller's
+    Newton on ``fine`` finishes (at once when the march ended converged).
+
+    Why: in deep mixed films (the paper's ground surfaces at 500 rpm, λ ≈ 0.1) the continuation in
+    the roughness amplitude of the steady problem meets a fold of the discrete branch on 513 nodes
+    (at 0.775 of the roughness a step of 1/2048 no longer converges, at a one-node asperity contact
+    whose pressure the neighbouring fluid node's flow coefficient sets), while the same
+    continuation with a squeeze term, which ties each node's film to a reference film, converges;
+    as Δτ grows the reference matters less and the state approaches the steady film. Newton from
+    the last state alone (no continuation) does not do: at 500 rpm and 1500 N m on 513 nodes its
+    steps failed from Δτ = Δx/ur on and shrank below Δx/(1024 ur) (measured 2026-11-27), where
+    the continuation's steps grew to 256 Δx/ur in 12 steps. A real transient step (σ > 0) is
+    marched to its own solution the same way: the pseudo term vanishes at a steady state of the
+    march."""
+    n = fine.n
+    dtype = u.dtype
+
+    def cond(carry):
+        _, multiple, count, _, done = carry
+        return (~done) & (count < steps) & (multiple >= _PSEUDO_SMALLEST)
+
+    def body(carry):
+        u, multiple, count, k, _ = carry
+        level = _with_pseudo_squeeze(fine, 1.0 / (fine.spacing * multiple), fine.rho_h(u))
+        u_new, k_new, reached = _adaptive_continuation(
+            model,
+            _rough_homotopy(level, rho_h_smooth),
+            u_smooth,
+            jnp.asarray(0),
+            jnp.zeros((), dtype),
+            model.roughness_steps,
+        )
+        ok = (reached >= 1.0) & jnp.all(jnp.isfinite(u_new))
+        change = _norm_inf(u_new[:n] - u[:n])
+        u = jnp.where(ok, u_new, u)
+        # the steady problem from a state that hardly moved (no iteration otherwise)
+        settle = ok & (change < SETTLE_CHANGE)
+        tries = jnp.where(settle, model.max_iterations, 0)
+        u_steady, _, k_steady, done = _newton(fine, u, 1.0, tries)
+        done = settle & done & jnp.all(jnp.isfinite(u_steady))
+        return (
+            jnp.where(done, u_steady, u),
+            jnp.where(ok, 2.0 * multiple, 0.5 * multiple),
+            count + 1,
+            k + k_new + k_steady,
+            done,
+        )
+
+    carry = (u, jnp.full((), 2.0, dtype), jnp.asarray(0), jnp.asarray(0), jnp.asarray(False))
+    u, _, _, k, _ = jax.lax.while_loop(cond, body, carry)
+    return u, k
 
 
 def _rough_homotopy(fine: _Level, rho_h_smooth):
@@ -1701,8 +1816,8 @@ def solve_ehl(
             lubrication with the roughness S1 + S2 in the film (paper Eq. 5), asperity contact
             where the film closes (Hu-Zhu unified Reynolds, paper Eq. 4b/4c) and boundary friction
             μb p there. The grid must resolve the roughness (Δx ≲ 1-3 µm).
-            A deep mixed steady film whose solve does not converge (500 rpm, ground, 513 nodes
-            and finer): ``jaxgear.lubrication.passage.settle_rough_film``.
+            A deep mixed deterministic film whose direct solve fails (500 rpm, ground, 513 nodes
+            and finer) is reached by pseudo-transient continuation (``model.pseudo_transient_steps``).
         initial: a previous EHLSolution to warm-start from (any contact; its p(x) is interpolated
             and its h0 reused). A failed warm start falls back to a cold solve.
         previous: the solution at the previous time step; with ``time_step`` Δt (s) the squeeze term

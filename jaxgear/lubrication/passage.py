@@ -19,6 +19,8 @@ order in Δt: halving Δt halves the time-discretisation error (tested).
 
 from __future__ import annotations
 
+import dataclasses
+
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -213,6 +215,10 @@ def solve_ehl_passage(
         raise ValueError("times are not increasing; valid: strictly increasing times, s")
     solids = (steel(), steel()) if solids is None else tuple(solids)
     mixed = "smooth" if surfaces is None else model.mixed
+    # the steps of a passage do not end in the pseudo-time march of a steady deterministic film
+    # (``ehl._pseudo_march``): measured on one engagement (257 nodes, 3500 rpm, 2026-11-27), it
+    # did not rescue the one step that failed, and it made the engagement cost 49 s against 33 s
+    model = dataclasses.replace(model, pseudo_transient_steps=0)
     return _passage(
         model,
         mixed,
@@ -223,104 +229,3 @@ def solve_ehl_passage(
         jnp.asarray(displacement, dtype=float),
         solids,
     )
-
-
-#: the largest pressure change of an accepted pseudo-time step (× ph) below which
-#: :func:`settle_rough_film` tries the steady solve from its state. Measured at the one case it was
-#: built for (500 rpm, pitch contact, ground, 513 nodes, 2026-11-27): the steady solve failed from
-#: states whose last step changed the pressure by 0.12-0.16 ph and converged, in 12 iterations,
-#: from one at 0.11 ph. A failed try costs a cold solve (~730 Newton iterations there).
-SETTLE_CHANGE = 0.12
-
-
-def settle_rough_film(
-    contact: LineContact,
-    lubricant: Lubricant,
-    model: EHLModel | None = None,
-    surfaces: Surfaces | None = None,
-    *,
-    displacement=None,
-    solids=None,
-    max_steps: int = 64,
-) -> EHLSolution:
-    """Steady deterministic rough film, by pseudo-transient continuation where the direct solve
-    fails.
-
-    First the steady :func:`~jaxgear.lubrication.ehl.solve_ehl`. If it does not converge, the same
-    contact (the roughness held where ``displacement`` puts it) is marched in pseudo-time from the
-    smooth steady film: backward-Euler steps with the squeeze term, starting at Δt = Δx/ur
-    (:func:`grid_time_step`), the step doubled after each converged step and halved after a failed
-    one (which is discarded). Once a step changes the pressure by less than ``SETTLE_CHANGE`` × ph,
-    the steady solve is tried from that state; its result is returned when it converges. The answer
-    is always a solution of the steady problem (``converged``): the march only supplies its start.
-    The function itself is eager and so not differentiable (traced inputs are rejected).
-
-    Why: in deep mixed films (the paper's ground surfaces at 500 rpm, λ ≈ 0.1) the continuation in
-    the roughness amplitude of the direct solve meets a fold of the discrete branch on 513 nodes
-    (at 0.775 of the roughness a step of 1/2048 no longer converges, at a one-node asperity contact
-    whose pressure the neighbouring fluid node's flow coefficient sets), while the transient steps,
-    whose squeeze term couples each node's film to its own previous value, converge. Measured
-    (2026-11-27, pitch contact, 700 N m, SRR 0.3): 33 pseudo-time steps at Δt of 1-8 Δx/ur, then
-    the steady solve in 12 iterations: p_max 5.9 ph, 5.9 % of the load on asperities; ~2 min; on
-    1025 nodes it converges as well (3 min). Three more cases on 513 nodes whose direct solve fails
-    (residual 0.10-0.20) settle: 500 rpm at SRR 0.6 (104 s), 500 rpm at 1500 N m (19 s) and
-    1000 rpm (34 s).
-
-    Eager: a Python loop of compiled solves (not for use under ``jit`` or ``vmap``).
-
-    Args:
-        contact, lubricant, model, surfaces, displacement, solids: as for ``solve_ehl``
-            (``surfaces`` required, ``model.mixed == "deterministic"``).
-        max_steps: most pseudo-time steps (accepted or not).
-
-    Returns:
-        EHLSolution of the steady problem: the direct solve's when it converged, the settled one
-        when that converged, otherwise the direct solve's (``converged`` False).
-    """
-    from .ehl import solve_ehl
-
-    model = EHLModel() if model is None else model
-    if not isinstance(model, EHLModel) or model.mixed != "deterministic":
-        raise ValueError(
-            f"model = {model!r} is not valid; valid: an EHLModel with mixed='deterministic'"
-        )
-    if not isinstance(surfaces, Surfaces):
-        raise ValueError(
-            f"surfaces = {type(surfaces).__name__} is not valid; valid: a Surfaces (rough film)"
-        )
-    if max_steps < 1:
-        raise ValueError(f"max_steps = {max_steps} is not valid; valid range: [1, inf)")
-    d = jnp.zeros(2) if displacement is None else jnp.asarray(displacement, dtype=float)
-    for leaf in jax.tree_util.tree_leaves((contact, surfaces, d)):
-        if not is_concrete(leaf):
-            raise ValueError(
-                "settle_rough_film runs eagerly (a Python loop of compiled solves); valid: "
-                "concrete inputs, not traced values under jit, vmap or grad"
-            )
-    kw = dict(displacement=d, solids=solids)
-    direct = solve_ehl(contact, lubricant, model, surfaces, **kw)
-    if bool(direct.converged):
-        return direct
-    smooth = solve_ehl(contact, lubricant, model, None, solids=solids)
-    if not bool(smooth.converged):
-        return direct
-    dt0 = grid_time_step(contact, lubricant, model)
-    state = solve_ehl(contact, lubricant, model, surfaces, previous=smooth, time_step=dt0, **kw)
-    if not bool(state.converged):
-        return direct
-    dt = 2.0 * dt0
-    ph = float(contact.hertz_pressure)
-    for _ in range(max_steps):
-        trial = solve_ehl(
-            contact, lubricant, model, surfaces, previous=state, time_step=dt, initial=state, **kw
-        )
-        if not bool(trial.converged):
-            dt = 0.5 * dt
-            continue
-        change = float(jnp.max(jnp.abs(trial.p - state.p))) / ph
-        state, dt = trial, 2.0 * dt
-        if change < SETTLE_CHANGE:
-            steady = solve_ehl(contact, lubricant, model, surfaces, initial=state, **kw)
-            if bool(steady.converged):
-                return steady
-    return direct
