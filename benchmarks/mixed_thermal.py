@@ -200,6 +200,7 @@ def engagement():
         ("smooth, thermal", dict(thermal=True), None, True),
         ("statistical mixed, thermal", dict(mixed="statistical", thermal=True), surf, True),
         ("deterministic mixed, iso-thermal", dict(mixed="deterministic"), surf, False),
+        ("deterministic mixed, thermal", dict(mixed="deterministic", thermal=True), surf, False),
     ]
     rows = []
     path_cases = [(f"{label}, along the path", kw, s, True) for label, kw, s, _ in cases]

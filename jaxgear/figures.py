@@ -68,13 +68,14 @@ FIELD_ROLL_ANGLE_DEG = {7: 25.0, 12: 17.0}
 #: Fig. 12 (and R10) solve the contact with the roughness profiles themselves (deterministic mixed
 #: EHL), as the paper does; the coupled model's statistical mixed rung gives the mean film only, with
 #: no asperity pressures to show. 513 nodes: Δx ≈ 3 µm at speed E, 17°, about 7 nodes per 20 µm
-#: correlation length of ``presets.ground()``. Finer is not yet reliable: at 1025 nodes the
-#: roughness continuation of that contact stalls at 0.97 of the roughness (residual 2e-2), while at
-#: the pitch contact 513 and 1025 nodes give the same p_max (6.64 GPa). Steady and iso-thermal: the
-#: thermal deterministic solve settles at the paper's ground roughness on 257 and 513 nodes (at
-#: speed E, to films 181 and 348 K hot at their hottest node: the deterministic Poiseuille heat's
-#: excess) but not on 1025; and the roughness is frozen at the instant (moving roughness:
-#: ``solve_ehl_passage``).
+#: correlation length of ``presets.ground()``. At 1025 nodes the roughness continuation of that
+#: contact stalled at 0.97 of the roughness (residual 2e-2), before a failed deterministic solve
+#: got the pseudo-time march (``EHLModel.pseudo_transient_steps``, 2026-11-27; not re-measured
+#: here since), while at the pitch contact 513 and 1025 nodes give the same p_max (6.64 GPa).
+#: Steady and iso-thermal: the thermal deterministic solve converges at the paper's ground
+#: roughness on 257, 513 and 1025 nodes (at speed E, to films 181, 348 and 440 K hot at their
+#: hottest node: the deterministic Poiseuille heat's excess, not grid-converged); and the
+#: roughness is frozen at the instant (moving roughness: ``solve_ehl_passage``).
 FIELD_DETERMINISTIC_NODES = 513
 
 BASELINE_INLET_C, VARIANT_INLET_C = 90.0, 60.0
