@@ -1259,9 +1259,10 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
 _PSEUDO = -3  # attempt kind: the pseudo-time march (deterministic roughness, after the cold ones)
 
 #: the largest pressure change of an accepted pseudo-time step (× ph) below which the march tries
-#: the steady problem from its state. Measured at the case it was built for (500 rpm, pitch
-#: contact, ground, 513 nodes, 2026-11-27): the steady solve failed from states whose last step
-#: changed the pressure by 0.12-0.16 ph and converged, in 12 iterations, from one at 0.11 ph.
+#: the steady problem from its state. Measured with the eager version of the march at the case it
+#: was built for (500 rpm, pitch contact, ground, 513 nodes, 2026-11-27): the steady solve failed
+#: from states whose last step changed the pressure by 0.12-0.16 ph and converged, in 12
+#: iterations, from one at 0.11 ph.
 SETTLE_CHANGE = 0.12
 _PSEUDO_SMALLEST = 2.0**-10  # the shortest pseudo-time step, × Δx/ur
 
