@@ -1753,7 +1753,19 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
         u, res, it, ok = _solve_core(model, True, mixed, inp_next, *args)
         new = _postprocess(model, mixed, inp_next, u, res, it, ok)
         new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol.iterations)
-        return new, inp_next, jnp.asarray(False), relax
+        # a deterministic film whose re-solve failed (every attempt) ends the iteration, reported
+        # not converged: the temperatures of a film that is not a Reynolds solution lead nowhere,
+        # and each further re-solve ran every cold attempt (~500 Newton iterations each). Measured
+        # on one thermal engagement along the path (257 nodes, same hour, against going on to the
+        # last update): 3500 rpm 66.3 against 77.4 s, 894 against 896 of 900 steps converged;
+        # 2000 rpm 72.6 against 99.5 s, 898 both (one step had burnt 30 000 iterations on 18
+        # failed re-solves); 4000 rpm 66.1 against 90.8 s, 893 against 890; 500 rpm no re-solve
+        # failed. A failed first solve still gets its updates: new temperatures can make it
+        # solvable (measured at 2000 rpm: 1 such step converged). Two failed solves in a row as
+        # the stop instead cascaded at 3500 rpm: the failed step's successor restarts steady,
+        # and from step 812 on every restart failed (807 of 900 converged).
+        stop = ~new.converged if mixed == "deterministic" else jnp.asarray(False)
+        return new, inp_next, stop, relax
 
     def step(op):
         sol, inp_k, relax, solids, transient = op
