@@ -122,6 +122,19 @@ def test_deterministic_transient_step_is_reached_from_the_previous_step_by_relax
     assert abs(float(relaxed.h0 - cold.h0)) < 1e-6 * float(relaxed.h_central)
 
 
+def test_relaxation_sweeps_default_to_100_iso_thermal_and_50_thermal_and_are_validated():
+    # The default (None) is resolved by the solve: 100 sweeps iso-thermal, 50 thermal (measured
+    # cheaper for the thermal passage, ``ehl._relaxation_sweeps``); a given count is used as is.
+    from jaxgear.lubrication.ehl import _relaxation_sweeps
+
+    assert _relaxation_sweeps(jg.EHLModel(mixed="deterministic")) == 100
+    assert _relaxation_sweeps(jg.EHLModel(mixed="deterministic", thermal=True)) == 50
+    assert _relaxation_sweeps(jg.EHLModel(thermal=True, relaxation_sweeps=7)) == 7
+    for bad in (-1, 2.5, True):
+        with pytest.raises(ValueError, match="relaxation_sweeps"):
+            jg.EHLModel(relaxation_sweeps=bad)
+
+
 def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_steady_film():
     # A transient step that falls back to the cold solve continues from the smooth steady film in
     # r, which scales the roughness and blends the squeeze term's previous film from the smooth
