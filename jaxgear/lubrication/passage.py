@@ -70,6 +70,9 @@ def _temperature_start(mixed, prev, x, inlet, shift):
     The temperature iteration's fixed point is unchanged (the mean loss over the converged steps
     moved by 0.7 % at 3500 rpm, 0.1 % at 2000 rpm: which discrete solution a step lands on). Smooth
     and statistical films, whose temperatures vary over the Hertz width, keep the unshifted start.
+    Measured earlier the same day, before a failed warm re-solve continued in the temperature
+    (``ehl._temperature_continuation``), the same start cost more: 211 631 against 141 633
+    iterations, when a re-solve that failed fell back to the cold solve.
     Tried and not kept (3500 rpm, same code otherwise): a continuation in the share of the time
     step for a first solve whose warm Newton failed (roughness, squeeze term and temperatures
     together from the previous step's solution): 87 Newton iterations a solve, 281 of 299
