@@ -94,7 +94,12 @@ def test_the_thermal_deterministic_passage_does_not_depend_on_where_its_temperat
 
     monkeypatch.setattr(passage_mod, "_temperature_start", unshifted)
     jax.clear_caches()  # the passage is traced again, with the start held
-    held = _held_passage(model, c, steps)
+    try:
+        held = _held_passage(model, c, steps)
+    finally:
+        # no later test in this process may reuse the program traced with the start held
+        monkeypatch.undo()
+        jax.clear_caches()
     assert bool(jnp.all(moved.converged)) and bool(jnp.all(held.converged))
     # the two solver paths differ (the patch took effect) ...
     assert int(jnp.sum(moved.iterations)) != int(jnp.sum(held.iterations))

@@ -1013,7 +1013,7 @@ _RELAX_ROUNDS = 3
 def _relaxation_sweeps(model: EHLModel) -> int:
     """The relaxation sweeps of a deterministic film's warm start: the model's, or by default 100
     iso-thermal and 50 thermal. Measured over one engagement along the path (257 nodes, ground,
-    900 steps, the same hour, 2026-11-27; run s / steps converged / Newton iterations):
+    900 steps, 2026-11-27, each column in one hour; run s / steps converged / Newton iterations):
 
     | sweeps | thermal, 3500 rpm | thermal, 500 rpm | iso-thermal, 3500 rpm | iso-thermal, 500 rpm |
     |---|---|---|---|---|
