@@ -264,6 +264,7 @@ _SURFACE_KEYS = {
     "seed": int,
     "rq_um": float,
     "correlation_length_um": float,
+    "short_cutoff_um": float,
 }
 _SWEEP_KEYS = {
     "speeds_rpm": list,
@@ -340,8 +341,8 @@ def lubricant_from_config(cfg: dict[str, Any]):
 
 def surfaces_from_config(cfg: dict[str, Any]):
     """``[surfaces]``: ``preset`` ("ground", "polished", "smooth"), ``scale`` (≥ 0), ``seed`` of the
-    synthetic profiles, and optionally ``rq_um`` / ``correlation_length_um`` for other synthetic
-    Gaussian profiles (REFERENCE §6)."""
+    synthetic profiles, and optionally ``rq_um`` / ``correlation_length_um`` / ``short_cutoff_um``
+    (the stylus cutoff λs) for other synthetic Gaussian profiles (REFERENCE §6)."""
     from . import presets
     from ._validation import check_non_negative, check_positive
     from .lubrication import roughness
@@ -363,6 +364,9 @@ def surfaces_from_config(cfg: dict[str, Any]):
     if "correlation_length_um" in table:
         check_positive("surfaces.correlation_length_um", table["correlation_length_um"], "µm")
         kwargs["correlation_length"] = table["correlation_length_um"] * 1e-6
+    if "short_cutoff_um" in table:
+        check_positive("surfaces.short_cutoff_um", table["short_cutoff_um"], "µm")
+        kwargs["short_cutoff"] = table["short_cutoff_um"] * 1e-6
     if name == "smooth":
         extra = sorted(set(table) - {"preset"})
         if extra:
@@ -376,7 +380,7 @@ def surfaces_from_config(cfg: dict[str, Any]):
     else:
         surf = getattr(presets, name)(scale=scale, seed=seed, **kwargs)
     return surf, {"preset": name, "scale": scale, "seed": seed} | {
-        k: table[k] for k in ("rq_um", "correlation_length_um") if k in table
+        k: table[k] for k in ("rq_um", "correlation_length_um", "short_cutoff_um") if k in table
     }
 
 

@@ -318,6 +318,7 @@ P = jg.presets
         (lambda: P.ground(seed=1.5), "seed", "1.5"),
         (lambda: P.ground(n=2), "n", "2"),
         (lambda: P.ground(correlation_length=0.0), "correlation_length", "0"),
+        (lambda: P.ground(short_cutoff=-2.5e-6), "short_cutoff", "-2.5e-06"),
         (lambda: P.smooth(n=2), "Surfaces.profile1", "(2,)"),
         (lambda: P.smooth(dx=0.0), "Surfaces.dx", "0"),
     ],

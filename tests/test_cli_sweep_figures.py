@@ -140,6 +140,7 @@ BAD = [
     ("[lubricant]\neyring_stress = -1.0\n" + SPEEDS, "lubricant.eyring_stress = -1 Pa is out"),
     ("[surfaces]\npreset = 'sandblasted'\n" + SPEEDS, "surfaces.preset = 'sandblasted'"),
     ("[surfaces]\nscale = -1.0\n" + SPEEDS, "surfaces.scale = -1 is out of range"),
+    ("[surfaces]\nshort_cutoff_um = 0.0\n" + SPEEDS, "surfaces.short_cutoff_um = 0"),
     ("[operating]\ntorque_Nm = -700\n" + SPEEDS, "operating.torque_Nm = -700 N m is out of range"),
     ("[operating]\nspeed_rpm = 1000.0\n" + SPEEDS, "operating.speed_rpm is not used"),
     ("[operating]\ninlet_temperature_C = 900\n" + SPEEDS, "operating.inlet_temperature_C = 900"),

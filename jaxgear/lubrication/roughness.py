@@ -11,6 +11,15 @@ x.
 The paper's measured profiles are not public; :func:`gaussian_profile` synthesises Gaussian profiles
 with an exponential autocorrelation R(τ) = Rq² exp(−|τ|/β) by spectral filtering of white noise
 (REFERENCE §6). The correlation length quoted everywhere is the 10 % decay length ℓ = β ln 10.
+
+Such a profile has no finest scale: its spectrum falls only as 1/f², so its rms slope grows as
+1/√Δx with the sampling (0.27 rad at the default 0.5 µm for the ground preset) and a finer EHL grid
+always meets sharper asperities. A measured profile has one: the stylus instrument's short-wave
+cutoff λs (ISO 3274; 2.5 µm with the 0.8 mm long-wave cutoff of ground gear flanks) removes what is
+shorter. ``short_cutoff`` applies that filter (the Gaussian profile filter of ISO 16610-21,
+amplitude transmission exp(−π (α λs/λ)²), α = √(ln 2/π): 50 % at λ = λs) to the synthetic profile,
+so that a grid of Δx ≤ ~λs/3 resolves it. The default (None) keeps the unfiltered profile, as the
+results in the README were computed with.
 """
 
 from __future__ import annotations
@@ -88,6 +97,17 @@ class Surfaces(eqx.Module):
         """Composite roughness σ = √(Rq1² + Rq2²), m."""
         return jnp.sqrt(jnp.sum(self.rq**2))
 
+    @property
+    def rms_slope(self) -> Float[Array, "2"]:
+        """Root-mean-square slope Δq of each surface (scaled), rad: of the periodic samples, by
+        central differences over 2 dx (so it depends on the sampling unless the profile is
+        band-limited well above 2 dx, e.g. by ``short_cutoff``)."""
+
+        def slope(z):
+            return _rms((jnp.roll(z, -1) - jnp.roll(z, 1)) / (2.0 * self.dx))
+
+        return jnp.stack([slope(self.profile1), slope(self.profile2)]) * jnp.abs(self.scale)
+
     # -- moving heights ---------------------------------------------------------------------------
     def height(self, index: int, x, t, velocity) -> Float[Array, ...]:
         """Roughness of surface ``index`` (0: gear 1, 1: gear 2) at contact-frame positions ``x``.
@@ -161,6 +181,18 @@ def periodic_cubic_interpolate(z: Float[Array, " n"], dx, xi) -> Float[Array, ..
     return out
 
 
+_GAUSSIAN_FILTER_ALPHA = math.sqrt(math.log(2.0) / math.pi)  # ISO 16610-21: 50 % at the cutoff
+
+
+def gaussian_filter_transmission(n: int, dx, cutoff) -> Float[Array, " n//2+1"]:
+    """Amplitude transmission of the ISO 16610-21 Gaussian low-pass profile filter of cutoff
+    wavelength ``cutoff`` (m) at the rfft bins of a periodic profile of ``n`` samples at spacing
+    ``dx``: exp(−π (α λs f)²), f = k/(n dx), α = √(ln 2/π), so 50 % at f = 1/λs. ``cutoff`` 0 passes
+    everything."""
+    f = jnp.arange(n // 2 + 1) / (n * dx)
+    return jnp.exp(-jnp.pi * (_GAUSSIAN_FILTER_ALPHA * cutoff * f) ** 2)
+
+
 def exponential_psd(n: int, dx, correlation_length) -> Float[Array, " n//2+1"]:
     """Discrete power spectrum (rfft bins) of the periodised autocorrelation exp(−|τ|/β), β = ℓ/ln
     10.
@@ -181,6 +213,7 @@ def gaussian_profile(
     dx: float = DEFAULT_SPACING,
     rq: float = 0.4e-6,
     correlation_length: float = DEFAULT_CORRELATION_LENGTH,
+    short_cutoff: float | None = None,
 ) -> Float[Array, " n"]:
     """Synthetic Gaussian roughness profile with exponential autocorrelation (REFERENCE §6).
 
@@ -188,7 +221,7 @@ def gaussian_profile(
     of the discrete spectrum of R(τ) = exp(−|τ|/β), β = ℓ / ln 10 (so R(ℓ) = 0.1). The mean is
     removed and the profile is rescaled so that its sample Rq equals ``rq`` exactly; the
     autocorrelation shape is a statistical property of the ensemble (the expected periodic
-    autocorrelation is exactly R).
+    autocorrelation is exactly R; with ``short_cutoff``, R smoothed at scales below λs).
 
     Args:
         key: ``jax.random`` key (reproducible: the same key gives the same profile).
@@ -196,6 +229,10 @@ def gaussian_profile(
         dx: spacing, m.
         rq: target root-mean-square height, m (≥ 0).
         correlation_length: ℓ, 10 % decay length of the autocorrelation, m (> 0).
+        short_cutoff: λs, m (> 0), or None (no filter): the short-wave cutoff of a stylus
+            measurement (ISO 3274: 2.5 µm for ground gears), applied as the ISO 16610-21 Gaussian
+            filter (:func:`gaussian_filter_transmission`) before the Rq is set. It should span a
+            few samples (λs ≥ 2 dx) to act.
 
     Returns:
         Heights, m, shape (n,), periodic.
@@ -203,25 +240,29 @@ def gaussian_profile(
     check_positive("dx", dx, "m")
     check_positive("correlation_length", correlation_length, "m")
     check_non_negative("rq", rq, "m")
+    if short_cutoff is not None:
+        check_positive("short_cutoff", short_cutoff, "m")
     if not isinstance(n, int | np.integer) or n < 4:
         raise ValueError(f"n = {n!r} is not valid; valid range: integer ≥ 4")
-    return _gaussian_profile(key, n, dx, rq, correlation_length)
+    cutoff = 0.0 if short_cutoff is None else short_cutoff
+    return _gaussian_profile(key, n, dx, rq, correlation_length, cutoff)
 
 
 @functools.partial(jax.jit, static_argnums=1)
-def _gaussian_profile(key, n, dx, rq, correlation_length):
+def _gaussian_profile(key, n, dx, rq, correlation_length, cutoff):
     noise = jax.random.normal(key, (n,), dtype=jnp.result_type(float))
     psd = exponential_psd(n, dx, correlation_length)
-    z = jnp.fft.irfft(jnp.fft.rfft(noise) * jnp.sqrt(psd), n=n)
+    gain = jnp.sqrt(psd) * gaussian_filter_transmission(n, dx, cutoff)
+    z = jnp.fft.irfft(jnp.fft.rfft(noise) * gain, n=n)
     z = z - jnp.mean(z)
     return rq * z / _rms(z)
 
 
-def _seeded_pair(seed, n, dx, rq, correlation_length):
+def _seeded_pair(seed, n, dx, rq, correlation_length, short_cutoff=None):
     k1, k2 = jax.random.split(jax.random.PRNGKey(seed))
     return (
-        gaussian_profile(k1, n, dx, rq, correlation_length),
-        gaussian_profile(k2, n, dx, rq, correlation_length),
+        gaussian_profile(k1, n, dx, rq, correlation_length, short_cutoff),
+        gaussian_profile(k2, n, dx, rq, correlation_length, short_cutoff),
     )
 
 
@@ -233,11 +274,13 @@ def synthetic(
     n: int = DEFAULT_POINTS,
     dx: float = DEFAULT_SPACING,
     correlation_length: float = DEFAULT_CORRELATION_LENGTH,
+    short_cutoff: float | None = None,
 ) -> Surfaces:
-    """Two independent synthetic Gaussian profiles of Rq ``rq`` (m) each, seeded by ``seed``."""
+    """Two independent synthetic Gaussian profiles of Rq ``rq`` (m) each, seeded by ``seed``
+    (``short_cutoff``: the stylus short-wave cutoff λs, m, or None; see :func:`gaussian_profile`)."""
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise ValueError(f"seed = {seed!r} is out of range; valid range: integer >= 0")
-    z1, z2 = _seeded_pair(seed, n, dx, rq, correlation_length)
+    z1, z2 = _seeded_pair(seed, n, dx, rq, correlation_length, short_cutoff)
     return Surfaces(profile1=z1, profile2=z2, dx=dx, scale=scale)
 
 
