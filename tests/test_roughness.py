@@ -325,3 +325,16 @@ def test_short_cutoff_passes_through_the_presets():
     assert np.all(np.asarray(a.rms_slope) < 0.8 * np.asarray(b.rms_slope))
     with pytest.raises(ValueError, match="short_cutoff"):
         jg.presets.polished(short_cutoff=0.0)
+
+
+def test_short_cutoff_from_a_sweep_config():
+    # the TOML key is in µm (units at the edges); the echo carries it into the sweep's summary
+    from jaxgear.config import surfaces_from_config
+
+    surf, echo = surfaces_from_config({"surfaces": {"preset": "ground", "short_cutoff_um": 2.5}})
+    ref = jg.presets.ground(short_cutoff=2.5e-6)
+    # 2.5 × 1e-6 and 2.5e-6 differ in the last bit: round-off tolerance (1e-18 m of 0.4 µm heights)
+    np.testing.assert_allclose(np.asarray(surf.profile1), np.asarray(ref.profile1), atol=1e-18)
+    assert echo["short_cutoff_um"] == 2.5
+    with pytest.raises(ValueError, match="surfaces.short_cutoff_um"):
+        surfaces_from_config({"surfaces": {"short_cutoff_um": -1.0}})
