@@ -1932,7 +1932,9 @@ def solve_ehl(
         surfaces: ``None`` (smooth) or a :class:`~jaxgear.lubrication.roughness.Surfaces`: mixed
             lubrication with the roughness S1 + S2 in the film (paper Eq. 5), asperity contact
             where the film closes (Hu-Zhu unified Reynolds, paper Eq. 4b/4c) and boundary friction
-            μb p there. The grid must resolve the roughness (Δx ≲ 1-3 µm).
+            μb p there. The grid must resolve the roughness: under-resolved features make
+            asperity contact a resolved film does not have (a waviness needs ≳ 13 nodes a
+            wavelength; ``benchmarks/roughness_resolution.py``).
             A deep mixed deterministic film whose direct solve fails (500 rpm, ground, 513 nodes
             and finer) is reached by pseudo-transient continuation (``model.pseudo_transient_steps``).
         initial: a previous EHLSolution to warm-start from (any contact; its p(x) is interpolated
