@@ -30,6 +30,33 @@ def machine() -> str:
     )
 
 
+ROWS_HELP = (
+    "JSON file of measured rows: rows found there are reused, new ones added as they are measured "
+    "(so a run that stops part way resumes; every row still comes from the script)"
+)
+
+
+class RowCache:
+    """Rows measured by a benchmark, kept in an optional JSON file (``--rows``) so that a long run
+    can be resumed or extended: ``cache.get(key, measure)`` returns the saved row or measures,
+    saves and returns it."""
+
+    def __init__(self, path: Path | None):
+        import json
+
+        self.path = path
+        self.saved = json.loads(path.read_text()) if path and path.exists() else {}
+
+    def get(self, key: str, measure):
+        import json
+
+        if key not in self.saved:
+            self.saved[key] = measure()
+            if self.path:
+                self.path.write_text(json.dumps(self.saved, indent=1))
+        return self.saved[key]
+
+
 def time_call(fn, *args, repeats: int = 20):
     """(compile+first-run seconds, median run seconds) of ``fn(*args)`` with block_until_ready."""
     import jax

@@ -22,7 +22,6 @@ Writes the section ``end_to_end`` of benchmarks/RESULTS.md. Run (repository root
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import subprocess
 import sys
@@ -36,7 +35,7 @@ jax.config.update("jax_enable_x64", True)
 
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
-from _report import machine, write_section  # noqa: E402
+from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 from jaxgear.tribodynamics import STATUS_NAMES  # noqa: E402
@@ -141,21 +140,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--skip-paper-sweep", action="store_true", help="no 149-speed paper() sweep")
     ap.add_argument("--skip-paper-gradient", action="store_true", help="no paper() gradient")
-    ap.add_argument(
-        "--rows",
-        type=Path,
-        help="JSON file of measured rows: rows found there are reused, new ones added as they are "
-        "measured (so a run that stops part way resumes; every row still comes from this script)",
-    )
+    ap.add_argument("--rows", type=Path, help=ROWS_HELP)
     args = ap.parse_args(argv)
-    saved = json.loads(args.rows.read_text()) if args.rows and args.rows.exists() else {}
-
-    def row(key, measure):
-        if key not in saved:
-            saved[key] = measure()
-            if args.rows:
-                args.rows.write_text(json.dumps(saved, indent=1))
-        return saved[key]
+    row = RowCache(args.rows).get
 
     def runs():
         cold = _jaxgear_run("off")

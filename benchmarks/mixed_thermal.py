@@ -19,6 +19,11 @@ each grid of ``--nodes``, the time step tied to each grid (Δt = Δx/ur: twice t
 nodes), at 500 and 3500 rpm: how its cost and loss move towards the issue's Δx ≤ 1 µm. Writes the
 ``mixed_engagement_grid`` section.
 
+``--held-steps K``: the deterministic passage's cost a step on each grid of ``--nodes`` (K steps
+of the held pitch-point contact, iso-thermal, 3500 rpm), and the engagement it implies, where the
+whole engagement is out of reach (2049 nodes: Δx 0.78 µm, the issue's ≤ 1 µm). Writes the
+``mixed_held_steps`` section.
+
 ``--passage-iterations``: where the deterministic passage spends its time: the Newton iterations
 of each step (all attempts) with the warm-start budget of the default model (12) and with 60, at
 500 and 3500 rpm on 257 nodes; writes the ``mixed_passage_iterations`` section.
@@ -68,11 +73,20 @@ def main(argv=None):
         action="store_true",
         help="the deterministic engagement on each grid of --nodes",
     )
+    ap.add_argument(
+        "--held-steps",
+        type=int,
+        default=0,
+        help="the deterministic passage's cost a step on each grid of --nodes (this many steps "
+        "of the held pitch-point contact at 3500 rpm, iso-thermal)",
+    )
     args = ap.parse_args(argv)
     if args.engagement:
         return engagement()
     if args.engagement_grid:
         return engagement_grid(args.nodes)
+    if args.held_steps:
+        return held_steps(args.nodes, args.held_steps)
     if args.passage_iterations:
         return passage_iterations(args.steps)
     surf = jg.presets.ground()
@@ -321,6 +335,66 @@ def engagement_grid(sizes):
         ]
     )
     write_section("mixed_engagement_grid", body)
+
+
+def held_steps(sizes, k):
+    """The deterministic passage's cost a step on finer grids, where a whole engagement is out of
+    reach: k steps of the held pitch-point contact (3500 rpm, iso-thermal, Δt = Δx/ur), the
+    compiled passage called twice; the time of a step from the second call's time per Newton
+    iteration and each step's iterations (the first, steady, solve left out)."""
+    import time
+
+    import numpy as np
+
+    rows = []
+    for n in sizes:
+        model = jg.EHLModel(n_nodes=n, mixed="deterministic")
+        c = gear_contact(rpm=3500.0)
+        dt = float(grid_time_step(c, LUB, model))
+        contacts = jax.tree_util.tree_map(lambda a, k=k: jnp.full((k,), a), c)
+        times = jnp.arange(k) * dt
+        fn = jax.jit(
+            lambda cs, t, model=model: solve_ehl_passage(
+                cs, LUB, model, jg.presets.ground(), times=t
+            )
+        )
+        t0 = time.perf_counter()
+        jax.block_until_ready(fn(contacts, times).p)
+        first = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        sol = fn(contacts, times * (1.0 + 1e-7))
+        jax.block_until_ready(sol.p)
+        run = time.perf_counter() - t0
+        its = np.asarray(sol.iterations)
+        per_it = run / its.sum()
+        per_step = per_it * its[1:].mean()
+        steps = _path_contacts(3500.0, model)[1].shape[0]
+        dx = float(sol.x[0, 1] - sol.x[0, 0])
+        rows.append(
+            f"| {n} | {dx * 1e6:.2f} | {first - run:.0f} | {int(its[0])} | "
+            f"{its[1:].mean():.0f} | {per_it * 1e3:.1f} | {per_step:.2f} | "
+            f"{int(np.sum(np.asarray(sol.converged)))} of {k} | {steps} | "
+            f"{per_step * steps / 3600.0:.2f} |"
+        )
+        print(rows[-1], flush=True)
+    body = "\n".join(
+        [
+            "## The deterministic passage a step on finer grids (`--held-steps`, issue 4)",
+            "",
+            f"Machine: {machine()}. The pitch-point contact held (700 N m, SRR 0.3, 3500 rpm), "
+            f"ground, iso-thermal, the default deterministic `EHLModel` on each grid; {k} steps of "
+            "Δt = Δx/ur, the first a steady solve. Compile: first call − second. A step: the "
+            "second call's time per Newton iteration × the mean iterations of steps 2…k. "
+            "Engagement: that × the steps of one engagement along the path on that grid (the "
+            "held contact costs about as much a step as the path's, `mixed_engagement`).",
+            "",
+            "| nodes | Δx, µm | compile, s | steady its | its a step | per iteration, ms | "
+            "per step, s | converged | steps per engagement | engagement, h |",
+            "|---|---|---|---|---|---|---|---|---|---|",
+            *rows,
+        ]
+    )
+    write_section("mixed_held_steps", body)
 
 
 def passage_iterations(k):

@@ -15,7 +15,6 @@ Writes the ``roughness_resolution`` section of benchmarks/RESULTS.md.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -30,7 +29,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
-from _report import machine, write_section  # noqa: E402
+from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
@@ -106,14 +105,9 @@ def main(argv=None):
         f"{SINE_WAVELENGTH * 1e6:.2f} µm on gear 1, gear 2 smooth (0: none)",
     )
     ap.add_argument("--rpm", type=float, default=3500.0)
-    ap.add_argument(
-        "--rows",
-        type=Path,
-        help="JSON file of measured rows: rows found there are reused, new ones added (so grids "
-        "and cutoffs can be measured in several runs; every row still comes from this script)",
-    )
+    ap.add_argument("--rows", type=Path, help=ROWS_HELP)
     args = ap.parse_args(argv)
-    saved = json.loads(args.rows.read_text()) if args.rows and args.rows.exists() else {}
+    cache = RowCache(args.rows)
     slopes = {}
     for cut in args.cutoffs:
         label = "unfiltered" if cut == 0.0 else f"λs = {cut:.1f} µm"
@@ -121,22 +115,16 @@ def main(argv=None):
         slopes[label] = np.asarray(surf.rms_slope).round(3).tolist()
         for n in args.nodes:
             key = f"{cut:g} {n} {args.rpm:g}"
-            if key not in saved:
-                saved[key] = _row(label, surf, n, args.rpm)
-                if args.rows:
-                    args.rows.write_text(json.dumps(saved, indent=1))
+            cache.get(key, lambda label=label, surf=surf, n=n: _row(label, surf, n, args.rpm))
     if args.sine_amplitude > 0.0:
         amp = args.sine_amplitude
         label = f"sine {SINE_WAVELENGTH * 1e6:.2f} µm, {amp:.2f} µm"
         for n in args.nodes:
             key = f"-{amp:g} {n} {args.rpm:g}"  # sorted before the Gaussian profiles
-            if key not in saved:
-                saved[key] = _row(label, _sine(amp * 1e-6), n, args.rpm)
-                if args.rows:
-                    args.rows.write_text(json.dumps(saved, indent=1))
+            cache.get(key, lambda label=label, n=n: _row(label, _sine(amp * 1e-6), n, args.rpm))
     rows = [
-        saved[k]
-        for k in sorted(saved, key=lambda k: tuple(float(v) for v in k.split()))
+        cache.saved[k]
+        for k in sorted(cache.saved, key=lambda k: tuple(float(v) for v in k.split()))
         if float(k.split()[2]) == args.rpm
     ]
     body = "\n".join(
