@@ -547,7 +547,7 @@ def test_thermal_passage_of_a_steady_state_reaches_the_steady_temperatures():
     # step to step) under a contact that does not change must settle on the steady solution's
     # (Jaeger) surface temperatures, and the friction with them. The solids start at the bulk
     # temperature, so the first steps are cooler. Catches a passage whose memory is fed a wrong heat
-    # flux (it once got the fluxes clipped at the 1500 K temperature bound: rises ≈ 0).
+    # flux (it once got the fluxes clipped at the temperature-rise bound: rises ≈ 0).
     model = jg.EHLModel(n_nodes=129, thermal=True)
     c = gear_contact(rpm=2000.0, slide_to_roll=1.0)
     steady = jg.solve_ehl(c, LUB, model)
@@ -568,3 +568,25 @@ def test_thermal_passage_of_a_steady_state_reaches_the_steady_temperatures():
     assert float(sols.friction_sliding[-1]) == pytest.approx(
         float(steady.friction_sliding), rel=2e-3
     )
+
+
+@pytest.mark.parametrize("lub", [jg.presets.mil_l_23699(), jg.presets.iso_vg68()])
+def test_bounded_temperatures_of_a_failed_solve_keep_the_lubricant_finite(lub):
+    # A failed thermal solve reports converged=False with finite values (ehl module contract). Its
+    # temperatures are bounded by ``_safe_rise``; at the bounds, for the ends of the valid inlet
+    # range, every lubricant property the film and its outputs use must be finite, and the density
+    # positive. (At the former +1500 K bound a 1025-node passage step reported NaN viscosities: the
+    # linear expansion's density changes sign near 1700 K.)
+    from jaxgear.lubrication import ehl
+
+    wild = jnp.asarray([-1e4, -60.0, 0.0, 1200.0, 1e4, jnp.inf, -jnp.inf, jnp.nan])
+    rise = ehl._safe_rise(wild)
+    assert bool(jnp.all(jnp.isfinite(rise)))
+    assert float(jnp.min(rise)) == ehl._MIN_RISE and float(jnp.max(rise)) == ehl._MAX_RISE
+    for inlet in (200.0, 600.0):
+        t = inlet + rise
+        for p in (0.0, 3e9):
+            assert bool(jnp.all(jnp.isfinite(lub.log_viscosity(p, t))))
+            assert bool(jnp.all(lub.density_at(p, t) > 0.0))
+        assert bool(jnp.all(jnp.isfinite(lub.pressure_viscosity_coefficient(t))))
+        assert bool(jnp.all(lub.density_at(0.0, t, compressible=False) > 0.0))
