@@ -44,7 +44,7 @@ import jax.numpy as jnp  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
-from _report import machine, time_call, write_section  # noqa: E402
+from _report import ROWS_HELP, RowCache, machine, time_call, write_section  # noqa: E402
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
@@ -80,13 +80,19 @@ def main(argv=None):
         help="the deterministic passage's cost a step on each grid of --nodes (this many steps "
         "of the held pitch-point contact at 3500 rpm, iso-thermal)",
     )
+    ap.add_argument(
+        "--thermal",
+        action="store_true",
+        help="with --held-steps: the thermal deterministic passage instead of the iso-thermal",
+    )
+    ap.add_argument("--rows", type=Path, help=ROWS_HELP + " (--held-steps)")
     args = ap.parse_args(argv)
     if args.engagement:
         return engagement()
     if args.engagement_grid:
         return engagement_grid(args.nodes)
     if args.held_steps:
-        return held_steps(args.nodes, args.held_steps)
+        return held_steps(args.nodes, args.held_steps, args.thermal, RowCache(args.rows))
     if args.passage_iterations:
         return passage_iterations(args.steps)
     surf = jg.presets.ground()
@@ -337,60 +343,71 @@ def engagement_grid(sizes):
     write_section("mixed_engagement_grid", body)
 
 
-def held_steps(sizes, k):
+def held_steps(sizes, k, thermal, cache):
     """The deterministic passage's cost a step on finer grids, where a whole engagement is out of
-    reach: k steps of the held pitch-point contact (3500 rpm, iso-thermal, Δt = Δx/ur), the
-    compiled passage called twice; the time of a step from the second call's time per Newton
-    iteration and each step's iterations (the first, steady, solve left out)."""
+    reach: k steps of the held pitch-point contact (3500 rpm, iso-thermal or thermal, Δt = Δx/ur),
+    the compiled passage called twice; the time of a step from the second call's time per Newton
+    iteration and each step's iterations (the first, steady, solve left out). Rows kept in
+    ``cache`` (``--rows``) so that iso-thermal and thermal runs share one table."""
+    label = "thermal" if thermal else "iso-thermal"
+    for n in sizes:
+        cache.get(f"{int(thermal)} {n}", lambda n=n: _held_row(n, k, thermal, label))
+    rows = [
+        cache.saved[key] for key in sorted(cache.saved, key=lambda s: tuple(map(int, s.split())))
+    ]
+    _write_held(rows, k)
+
+
+def _held_row(n, k, thermal, label):
     import time
 
     import numpy as np
 
-    rows = []
-    for n in sizes:
-        model = jg.EHLModel(n_nodes=n, mixed="deterministic")
-        c = gear_contact(rpm=3500.0)
-        dt = float(grid_time_step(c, LUB, model))
-        contacts = jax.tree_util.tree_map(lambda a, k=k: jnp.full((k,), a), c)
-        times = jnp.arange(k) * dt
-        fn = jax.jit(
-            lambda cs, t, model=model: solve_ehl_passage(
-                cs, LUB, model, jg.presets.ground(), times=t
-            )
-        )
-        t0 = time.perf_counter()
-        jax.block_until_ready(fn(contacts, times).p)
-        first = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        sol = fn(contacts, times * (1.0 + 1e-7))
-        jax.block_until_ready(sol.p)
-        run = time.perf_counter() - t0
-        its = np.asarray(sol.iterations)
-        per_it = run / its.sum()
-        per_step = per_it * its[1:].mean()
-        steps = _path_contacts(3500.0, model)[1].shape[0]
-        dx = float(sol.x[0, 1] - sol.x[0, 0])
-        rows.append(
-            f"| {n} | {dx * 1e6:.2f} | {first - run:.0f} | {int(its[0])} | "
-            f"{its[1:].mean():.0f} | {per_it * 1e3:.1f} | {per_step:.2f} | "
-            f"{int(np.sum(np.asarray(sol.converged)))} of {k} | {steps} | "
-            f"{per_step * steps / 3600.0:.2f} |"
-        )
-        print(rows[-1], flush=True)
+    model = jg.EHLModel(n_nodes=n, mixed="deterministic", thermal=thermal)
+    c = gear_contact(rpm=3500.0)
+    dt = float(grid_time_step(c, LUB, model))
+    contacts = jax.tree_util.tree_map(lambda a, k=k: jnp.full((k,), a), c)
+    times = jnp.arange(k) * dt
+    fn = jax.jit(
+        lambda cs, t, model=model: solve_ehl_passage(cs, LUB, model, jg.presets.ground(), times=t)
+    )
+    t0 = time.perf_counter()
+    jax.block_until_ready(fn(contacts, times).p)
+    first = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    sol = fn(contacts, times * (1.0 + 1e-7))
+    jax.block_until_ready(sol.p)
+    run = time.perf_counter() - t0
+    its = np.asarray(sol.iterations)
+    per_it = run / its.sum()
+    per_step = per_it * its[1:].mean()
+    steps = _path_contacts(3500.0, model)[1].shape[0]
+    dx = float(sol.x[0, 1] - sol.x[0, 0])
+    row = (
+        f"| {label} | {n} | {dx * 1e6:.2f} | {first - run:.0f} | {int(its[0])} | "
+        f"{its[1:].mean():.0f} | {per_it * 1e3:.1f} | {per_step:.2f} | "
+        f"{int(np.sum(np.asarray(sol.converged)))} of {k} | {steps} | "
+        f"{per_step * steps / 3600.0:.2f} |"
+    )
+    print(row, flush=True)
+    return row
+
+
+def _write_held(rows, k):
     body = "\n".join(
         [
             "## The deterministic passage a step on finer grids (`--held-steps`, issue 4)",
             "",
             f"Machine: {machine()}. The pitch-point contact held (700 N m, SRR 0.3, 3500 rpm), "
-            f"ground, iso-thermal, the default deterministic `EHLModel` on each grid; {k} steps of "
+            f"ground, the default deterministic `EHLModel` on each grid; {k} steps of "
             "Δt = Δx/ur, the first a steady solve. Compile: first call − second. A step: the "
             "second call's time per Newton iteration × the mean iterations of steps 2…k. "
             "Engagement: that × the steps of one engagement along the path on that grid (the "
             "held contact costs about as much a step as the path's, `mixed_engagement`).",
             "",
-            "| nodes | Δx, µm | compile, s | steady its | its a step | per iteration, ms | "
+            "| model | nodes | Δx, µm | compile, s | steady its | its a step | per iteration, ms | "
             "per step, s | converged | steps per engagement | engagement, h |",
-            "|---|---|---|---|---|---|---|---|---|---|",
+            "|---|---|---|---|---|---|---|---|---|---|---|",
             *rows,
         ]
     )
