@@ -13,12 +13,15 @@ with an exponential autocorrelation R(τ) = Rq² exp(−|τ|/β) by spectral fil
 (REFERENCE §6). The correlation length quoted everywhere is the 10 % decay length ℓ = β ln 10.
 
 Such a profile has no finest scale: its spectrum falls only as 1/f², so its rms slope grows as
-1/√Δx with the sampling (0.27 rad at the default 0.5 µm for the ground preset) and a finer EHL grid
-always meets sharper asperities. A measured profile has one: the stylus instrument's short-wave
-cutoff λs (ISO 3274; 2.5 µm with the 0.8 mm long-wave cutoff of ground gear flanks) removes what is
-shorter. ``short_cutoff`` applies that filter (the Gaussian profile filter of ISO 16610-21,
-amplitude transmission exp(−π (α λs/λ)²), α = √(ln 2/π): 50 % at λ = λs) to the synthetic profile,
-so that a grid of Δx ≤ ~λs/3 resolves it. The default (None) keeps the unfiltered profile, as the
+1/√Δx with the sampling (0.19-0.20 rad by central differences at the default 0.5 µm for the ground
+preset) and a finer EHL grid always meets sharper asperities. A measured profile has one: the
+stylus instrument's short-wave cutoff λs (ISO 3274; 2.5 µm with the 0.8 mm long-wave cutoff of
+ground gear flanks) removes what is shorter. ``short_cutoff`` applies that filter (the Gaussian
+profile filter of ISO 16610-21, amplitude transmission exp(−π (α λs/λ)²), α = √(ln 2/π): 50 % at
+λ = λs) to the synthetic profile, whose rms slope then no longer depends on a sampling finer than
+~λs/10. An EHL grid needs more still: under-resolved roughness makes asperity contact a resolved
+film does not have, and a waviness is resolved from ~13 nodes a wavelength
+(``benchmarks/roughness_resolution.py``). The default (None) keeps the unfiltered profile, as the
 results in the README were computed with.
 """
 
