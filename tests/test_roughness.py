@@ -262,9 +262,9 @@ def _filtered_slope_closed_form(rq, beta, cutoff):
 
     Two-sided spectrum S(f) = 2β Rq² / (1 + (2πβf)²), transmission A(f)² = exp(−a f²),
     a = 2π α² λs²: Δq² = ∫ (2πf)² S A² df = (2 Rq²/β) [√(π/a) − ∫ A²/(1 + (2πβf)²) df], and
-    ∫ exp(−a f²)/(1 + b² f²) df = (π/b) exp(a/b²) erfc(√a/b), b = 2πβ. (The filter's few-%
-    removal of the variance is undone by the Rq normalisation: divide by the transmitted variance
-    ∫ S A² df / Rq² = (2β/b) π exp(a/b²) erfc(√a/b) · ... computed the same way.)"""
+    ∫ exp(−a f²)/(1 + b² f²) df = (π/b) exp(a/b²) erfc(√a/b), b = 2πβ. The filter removes a few %
+    of the variance, which the Rq normalisation restores: Δq² is divided by the transmitted share
+    ∫ S A² df / Rq² = 2β ∫ A²/(1 + b² f²) df, the same integral."""
     alpha = math.sqrt(math.log(2.0) / math.pi)
     a = 2.0 * math.pi * alpha**2 * cutoff**2
     b = 2.0 * math.pi * beta
