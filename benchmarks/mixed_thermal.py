@@ -19,10 +19,11 @@ each grid of ``--nodes``, the time step tied to each grid (Δt = Δx/ur: twice t
 nodes), at 500 and 3500 rpm: how its cost and loss move towards the issue's Δx ≤ 1 µm. Writes the
 ``mixed_engagement_grid`` section.
 
-``--held-steps K``: the deterministic passage's cost a step on each grid of ``--nodes`` (K steps
-of the held pitch-point contact, iso-thermal, 3500 rpm), and the engagement it implies, where the
-whole engagement is out of reach (2049 nodes: Δx 0.78 µm, the issue's ≤ 1 µm). Writes the
-``mixed_held_steps`` section.
+``--held-steps K [--thermal] [--rows FILE]``: the deterministic passage's cost a step on each grid
+of ``--nodes`` (K steps of the held pitch-point contact, 3500 rpm, iso-thermal or with
+``--thermal`` the thermal passage), and the engagement it implies, where the whole engagement is
+out of reach (2049 nodes: Δx 0.78 µm, the issue's ≤ 1 µm). ``--rows`` keeps the rows of both
+passages in one table across runs. Writes the ``mixed_held_steps`` section.
 
 ``--passage-iterations``: where the deterministic passage spends its time: the Newton iterations
 of each step (all attempts) with the warm-start budget of the default model (12) and with 60, at
@@ -78,7 +79,7 @@ def main(argv=None):
         type=int,
         default=0,
         help="the deterministic passage's cost a step on each grid of --nodes (this many steps "
-        "of the held pitch-point contact at 3500 rpm, iso-thermal)",
+        "of the held pitch-point contact at 3500 rpm; iso-thermal unless --thermal)",
     )
     ap.add_argument(
         "--thermal",
