@@ -8,7 +8,8 @@ stylus instrument's short-wave cutoff λs (ISO 3274: 2.5 µm for ground gear fla
 This benchmark solves the same steady deterministic contact (the pitch point at speed E, iso-thermal)
 on each grid with both profiles and reports how the film, the asperity load and the loss move.
 
-Run: ``python benchmarks/roughness_resolution.py [--nodes 257 513 1025 2049] [--rpm 3500]``.
+Run: ``python benchmarks/roughness_resolution.py [--nodes 257 513 1025 2049] [--rpm 3500]
+[--polished] [--rows FILE.json]``.
 Writes the ``roughness_resolution`` section of benchmarks/RESULTS.md.
 """
 
@@ -104,17 +105,24 @@ def main(argv=None):
         help="also a single sinusoidal waviness of this amplitude (µm) and wavelength "
         f"{SINE_WAVELENGTH * 1e6:.2f} µm on gear 1, gear 2 smooth (0: none)",
     )
+    ap.add_argument(
+        "--polished",
+        action="store_true",
+        help="the polished surfaces (Rq 0.05 µm per surface) instead of the ground ones",
+    )
     ap.add_argument("--rpm", type=float, default=3500.0)
     ap.add_argument("--rows", type=Path, help=ROWS_HELP)
     args = ap.parse_args(argv)
     cache = RowCache(args.rows)
     slopes = {}
+    make, prefix = (jg.presets.polished, "p ") if args.polished else (jg.presets.ground, "")
     for cut in args.cutoffs:
         label = "unfiltered" if cut == 0.0 else f"λs = {cut:.1f} µm"
-        surf = jg.presets.ground(short_cutoff=None if cut == 0.0 else cut * 1e-6)
+        label = f"polished, {label}" if args.polished else label
+        surf = make(short_cutoff=None if cut == 0.0 else cut * 1e-6)
         slopes[label] = np.asarray(surf.rms_slope).round(3).tolist()
         for n in args.nodes:
-            key = f"{cut:g} {n} {args.rpm:g}"
+            key = f"{prefix}{cut:g} {n} {args.rpm:g}"
             cache.get(key, lambda label=label, surf=surf, n=n: _row(label, surf, n, args.rpm))
     if args.sine_amplitude > 0.0:
         amp = args.sine_amplitude
@@ -122,18 +130,21 @@ def main(argv=None):
         for n in args.nodes:
             key = f"-{amp:g} {n} {args.rpm:g}"  # sorted before the Gaussian profiles
             cache.get(key, lambda label=label, n=n: _row(label, _sine(amp * 1e-6), n, args.rpm))
-    rows = [
-        cache.saved[k]
-        for k in sorted(cache.saved, key=lambda k: tuple(float(v) for v in k.split()))
-        if float(k.split()[2]) == args.rpm
-    ]
+
+    def order(key):
+        # ground rows (the sine first), then the polished ones ("p " keys); by cutoff and grid
+        polished = key.startswith("p ")
+        return (polished, *(float(v) for v in key.removeprefix("p ").split()))
+
+    rows = [cache.saved[k] for k in sorted(cache.saved, key=order) if order(k)[3] == args.rpm]
     body = "\n".join(
         [
             "## Roughness resolution: the deterministic film on finer grids "
             "(`benchmarks/roughness_resolution.py`, issue 4)",
             "",
             f"Machine: {machine()}. Pitch-point contact, {args.rpm:.0f} rpm, 700 N m, SRR 0.3, "
-            "ground (Rq 0.40 µm per surface, ℓ 20 µm, seed 0), iso-thermal steady deterministic "
+            "ground (Rq 0.40 µm per surface, ℓ 20 µm, seed 0; polished rows: Rq 0.05 µm), "
+            "iso-thermal steady deterministic "
             'solve (the default `EHLModel(mixed="deterministic")` on each grid). Δq: rms slope of '
             "S1 + S2 as the grid samples it. Wall: one call, compilation included. Loss per "
             "contact over the 20 mm face width. The profiles' own Δq at their 0.5 µm sampling "
