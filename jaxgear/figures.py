@@ -67,16 +67,24 @@ NEARLY_EQUAL = 0.03
 FIELD_ROLL_ANGLE_DEG = {7: 25.0, 12: 17.0}
 #: Fig. 12 (and R10) solve the contact with the roughness profiles themselves (deterministic mixed
 #: EHL), as the paper does; the coupled model's statistical mixed rung gives the mean film only, with
-#: no asperity pressures to show. 513 nodes: Δx ≈ 3 µm at speed E, 17°, about 7 nodes per 20 µm
-#: correlation length of ``presets.ground()``. At 1025 nodes the roughness continuation of that
-#: contact stalled at 0.97 of the roughness (residual 2e-2), before a failed deterministic solve
-#: got the pseudo-time march (``EHLModel.pseudo_transient_steps``, 2026-11-27; not re-measured
-#: here since), while at the pitch contact 513 and 1025 nodes give the same p_max (6.64 GPa).
-#: Steady and iso-thermal: the thermal deterministic solve converges at the paper's ground
-#: roughness on 257, 513 and 1025 nodes (at speed E, to films 181, 348 and 440 K hot at their
-#: hottest node: the deterministic Poiseuille heat's excess, not grid-converged); and the
-#: roughness is frozen at the instant (moving roughness: ``solve_ehl_passage``).
-FIELD_DETERMINISTIC_NODES = 513
+#: no asperity pressures to show. The profiles are the runs' synthetic surfaces as a stylus
+#: instrument measures them (``field_surfaces``): band-limited at λs = 2.5 µm, the ISO 3274 cutoff
+#: for λc = 0.8 mm (the paper put measured profiles in its film). Unfiltered, the exponential
+#: autocorrelation has no finest scale and the film moves with the grid (RESULTS
+#: ``roughness_resolution``). Filtered, this contact settles by 2049 nodes (Δx ≈ 0.5 µm at 17°):
+#: at the quasi-static 17° contact at 3500 rpm (RESULTS ``fig12_resolution``) polished p_max 1.750
+#: / 1.745 / 1.737 GPa and h_min 0.188 / 0.190 / 0.189 µm on 1025 / 2049 / 4097 nodes, ground
+#: p_max 4.94 / 4.86 GPa on 1025 / 2049 (29 s for the ground solve on 2049 nodes). The ground
+#: film's asperity load is what still moves (1.6 % of the load on 1025 nodes, none on 2049: the
+#: > 3 GPa peaks are micro-EHL pressure in a film 26 nm thin at its thinnest), as at the pitch
+#: contact, where that film needs Δx ≲ λs/13 (``roughness_resolution``); a ground solve on 4097
+#: nodes at the pitch contact did not finish in 20 min. (On 513 unfiltered nodes, the setting
+#: before 2026-11-27, the polished p_max came out 1.80 GPa here and 2.00 GPa at the paper
+#: fidelity's speed E.) Steady and iso-thermal: the thermal deterministic film's Poiseuille heat
+#: is not grid-converged (README, Deterministic roughness); and the roughness is frozen at the
+#: instant (moving roughness: ``solve_ehl_passage``).
+FIELD_DETERMINISTIC_NODES = 2049
+FIELD_SHORT_CUTOFF = 2.5e-6  # m, λs of ISO 3274 for λc = 0.8 mm (ground and polished flanks)
 
 BASELINE_INLET_C, VARIANT_INLET_C = 90.0, 60.0
 BASELINE_TORQUE, VARIANT_TORQUE = 700.0, 1500.0
@@ -437,11 +445,38 @@ def _contact_fields(repro: PaperReproduction) -> None:
         repro.fields[key] = field
 
 
+def field_contact(repro: PaperReproduction, result, index: int, i: int, slot: int):
+    """The LineContact of tooth pair ``slot`` at mesh position ``i`` of point ``index`` of
+    ``result`` (a SweepResult of ``repro``): its dynamic load, radii and surface velocities."""
+    from .lubrication.ehl import LineContact
+    from .material import reduced_modulus
+
+    u = result.surface_velocity[index, i, slot]
+    return LineContact(
+        reduced_radius=float(repro.mesh.reduced_radius[i, slot]),
+        load_per_width=float(result.tooth_force[index, i, slot]) / float(repro.pair.face_width),
+        u1=float(u[0]),
+        u2=float(u[1]),
+        e_reduced=reduced_modulus(*repro.pair.materials),
+        inlet_temperature=repro.op.inlet_temperature,
+    )
+
+
+def field_surfaces(kind: str):
+    """The roughness profiles Fig. 12 and R10 put in the film: the runs' synthetic surfaces
+    (``presets.ground()`` / ``presets.polished()``: the same seed, Rq and correlation length) as a
+    stylus instrument measures them, band-limited at λs = FIELD_SHORT_CUTOFF (see
+    FIELD_DETERMINISTIC_NODES for why)."""
+    from . import presets
+
+    make = {"ground": presets.ground, "polished": presets.polished}[kind]
+    return make(short_cutoff=FIELD_SHORT_CUTOFF)
+
+
 def _solve_contact(repro, result, index, i, slot, label, deterministic=False):
     """(EHLSolution, description, thermal) of one tooth contact of ``result``."""
     from .lubrication.contacts import ehl_model_of
-    from .lubrication.ehl import EHLModel, LineContact, solve_ehl
-    from .material import reduced_modulus
+    from .lubrication.ehl import EHLModel, solve_ehl
 
     fid = repro.fidelity
     surfaces = None
@@ -456,24 +491,21 @@ def _solve_contact(repro, result, index, i, slot, label, deterministic=False):
             limiting_shear_coefficient=fid.limiting_shear_coefficient,
         )
         what = (
-            f"deterministic roughness, {FIELD_DETERMINISTIC_NODES} nodes, steady, iso-thermal "
-            "snapshot at the coupled model's dynamic load"
+            f"deterministic roughness (profiles filtered at λs = {FIELD_SHORT_CUTOFF * 1e6:g} "
+            f"µm), {FIELD_DETERMINISTIC_NODES} nodes, steady, iso-thermal snapshot at the "
+            "coupled model's dynamic load"
         )
     else:
         what = f"{fid.friction} rung of the coupled model, {fid.n_nodes} nodes"
         if fid.friction == "ehl_mixed":
             what += f" ({fid.mixed_model} roughness)"
     if fid.friction == "ehl_mixed":
-        surfaces = repro.polished if "polished" in label else repro.surfaces
-    u = result.surface_velocity[index, i, slot]
-    contact = LineContact(
-        reduced_radius=float(repro.mesh.reduced_radius[i, slot]),
-        load_per_width=float(result.tooth_force[index, i, slot]) / float(repro.pair.face_width),
-        u1=float(u[0]),
-        u2=float(u[1]),
-        e_reduced=reduced_modulus(*repro.pair.materials),
-        inlet_temperature=repro.op.inlet_temperature,
-    )
+        polished = "polished" in label
+        if deterministic:
+            surfaces = field_surfaces("polished" if polished else "ground")
+        else:
+            surfaces = repro.polished if polished else repro.surfaces
+    contact = field_contact(repro, result, index, i, slot)
     sol = solve_ehl(contact, repro.lubricant, model, surfaces)
     if not bool(sol.converged):
         what += f"; NOT CONVERGED (residual {float(sol.residual):.1e})"
