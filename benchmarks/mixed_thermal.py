@@ -19,10 +19,11 @@ each grid of ``--nodes``, the time step tied to each grid (Δt = Δx/ur: twice t
 nodes), at 500 and 3500 rpm: how its cost and loss move towards the issue's Δx ≤ 1 µm. Writes the
 ``mixed_engagement_grid`` section.
 
-``--held-steps K [--thermal] [--rows FILE]``: the deterministic passage's cost a step on each grid
-of ``--nodes`` (K steps of the held pitch-point contact, 3500 rpm, iso-thermal or with
-``--thermal`` the thermal passage), and the engagement it implies, where the whole engagement is
-out of reach (2049 nodes: Δx 0.78 µm, the issue's ≤ 1 µm). ``--rows`` keeps the rows of both
+``--held-steps K [--thermal] [--polished] [--rows FILE]``: the deterministic passage's cost a
+step on each grid of ``--nodes`` (K steps of the held pitch-point contact, 3500 rpm, iso-thermal or
+with ``--thermal`` the thermal passage; ``--polished``: the polished surfaces filtered at λs = 2.5
+µm, a full film), and the engagement it implies, where the whole engagement is out of reach (2049
+nodes: Δx 0.78 µm, the issue's ≤ 1 µm). ``--rows`` keeps the rows of all these
 passages in one table across runs. Writes the ``mixed_held_steps`` section.
 
 ``--passage-iterations``: where the deterministic passage spends its time: the Newton iterations
@@ -86,6 +87,12 @@ def main(argv=None):
         action="store_true",
         help="with --held-steps: the thermal deterministic passage instead of the iso-thermal",
     )
+    ap.add_argument(
+        "--polished",
+        action="store_true",
+        help="with --held-steps: the polished surfaces filtered at the stylus cutoff λs = 2.5 µm "
+        "(a full film) instead of the ground ones",
+    )
     ap.add_argument("--rows", type=Path, help=ROWS_HELP + " (--held-steps)")
     args = ap.parse_args(argv)
     if args.engagement:
@@ -93,7 +100,9 @@ def main(argv=None):
     if args.engagement_grid:
         return engagement_grid(args.nodes)
     if args.held_steps:
-        return held_steps(args.nodes, args.held_steps, args.thermal, RowCache(args.rows))
+        return held_steps(
+            args.nodes, args.held_steps, args.thermal, RowCache(args.rows), args.polished
+        )
     if args.passage_iterations:
         return passage_iterations(args.steps)
     surf = jg.presets.ground()
@@ -344,22 +353,25 @@ def engagement_grid(sizes):
     write_section("mixed_engagement_grid", body)
 
 
-def held_steps(sizes, k, thermal, cache):
+def held_steps(sizes, k, thermal, cache, polished=False):
     """The deterministic passage's cost a step on finer grids, where a whole engagement is out of
     reach: k steps of the held pitch-point contact (3500 rpm, iso-thermal or thermal, Δt = Δx/ur),
     the compiled passage called twice; the time of a step from the second call's time per Newton
     iteration and each step's iterations (the first, steady, solve left out). Rows kept in
-    ``cache`` (``--rows``) so that iso-thermal and thermal runs share one table."""
+    ``cache`` (``--rows``) so that iso-thermal and thermal runs share one table. ``polished``: the
+    polished surfaces filtered at λs = 2.5 µm (a full film) instead of the ground ones."""
     label = "thermal" if thermal else "iso-thermal"
+    label += ", polished (λs 2.5 µm)" if polished else ""
+    group = int(thermal) + (2 if polished else 0)
     for n in sizes:
-        cache.get(f"{int(thermal)} {n}", lambda n=n: _held_row(n, k, thermal, label))
+        cache.get(f"{group} {n}", lambda n=n: _held_row(n, k, thermal, label, polished))
     rows = [
         cache.saved[key] for key in sorted(cache.saved, key=lambda s: tuple(map(int, s.split())))
     ]
     _write_held(rows, k)
 
 
-def _held_row(n, k, thermal, label):
+def _held_row(n, k, thermal, label, polished=False):
     import time
 
     import numpy as np
@@ -369,9 +381,8 @@ def _held_row(n, k, thermal, label):
     dt = float(grid_time_step(c, LUB, model))
     contacts = jax.tree_util.tree_map(lambda a, k=k: jnp.full((k,), a), c)
     times = jnp.arange(k) * dt
-    fn = jax.jit(
-        lambda cs, t, model=model: solve_ehl_passage(cs, LUB, model, jg.presets.ground(), times=t)
-    )
+    surf = jg.presets.polished(short_cutoff=2.5e-6) if polished else jg.presets.ground()
+    fn = jax.jit(lambda cs, t, model=model: solve_ehl_passage(cs, LUB, model, surf, times=t))
     t0 = time.perf_counter()
     jax.block_until_ready(fn(contacts, times).p)
     first = time.perf_counter() - t0
@@ -400,7 +411,8 @@ def _write_held(rows, k):
             "## The deterministic passage a step on finer grids (`--held-steps`, issue 4)",
             "",
             f"Machine: {machine()}. The pitch-point contact held (700 N m, SRR 0.3, 3500 rpm), "
-            f"ground, the default deterministic `EHLModel` on each grid; {k} steps of "
+            f"ground (polished rows: Rq 0.05 µm, filtered at λs = 2.5 µm), the default "
+            f"deterministic `EHLModel` on each grid; {k} steps of "
             "Δt = Δx/ur, the first a steady solve. Compile: first call − second. A step: the "
             "second call's time per Newton iteration × the mean iterations of steps 2…k. "
             "Engagement: that × the steps of one engagement along the path on that grid (the "
