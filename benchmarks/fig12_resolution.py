@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import jax
@@ -29,6 +28,7 @@ jax.config.update("jax_enable_x64", True)
 sys.path.insert(0, str(Path(__file__).parent))
 
 from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
+from roughness_resolution import add_cutoffs, timed_solve  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 from jaxgear import figures  # noqa: E402
@@ -57,11 +57,7 @@ def _surfaces(kind: str, cutoff_um: float):
 
 
 def _row(contact, lub, kind, cutoff_um, n):
-    model = jg.EHLModel(n_nodes=n, mixed="deterministic")
-    t0 = time.perf_counter()
-    sol = jg.solve_ehl(contact, lub, model, _surfaces(kind, cutoff_um))
-    jax.block_until_ready(sol.p)
-    wall = time.perf_counter() - t0
+    sol, wall = timed_solve(contact, lub, _surfaces(kind, cutoff_um), n)
     dx = float(sol.x[1] - sol.x[0])
     label = "unfiltered" if cutoff_um == 0.0 else f"λs = {cutoff_um:g} µm"
     row = (
@@ -77,13 +73,7 @@ def _row(contact, lub, kind, cutoff_um, n):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--nodes", type=int, nargs="+", default=[513, 1025, 2049, 4097])
-    ap.add_argument(
-        "--cutoffs",
-        type=float,
-        nargs="+",
-        default=[0.0, figures.FIELD_SHORT_CUTOFF * 1e6],
-        help="short-wave cutoffs λs, µm (0: the unfiltered profile)",
-    )
+    add_cutoffs(ap, [0.0, figures.FIELD_SHORT_CUTOFF * 1e6])
     ap.add_argument("--kinds", nargs="+", default=["polished", "ground"])
     ap.add_argument("--rpm", type=float, default=3500.0)
     ap.add_argument("--rows", type=Path, help=ROWS_HELP)

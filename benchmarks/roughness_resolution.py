@@ -67,13 +67,30 @@ def _hertz_mean(h, x, contact):
     return float(jnp.sum(jnp.where(inside, h, 0.0)) / jnp.sum(inside))
 
 
-def _row(label, surf, n, rpm):
-    contact = gear_contact(rpm=rpm)
+def timed_solve(contact, lub, surf, n):
+    """The steady deterministic solve of ``contact`` with the profiles ``surf`` on ``n`` nodes
+    (the profiles at their origin), and its wall time, s (one call, compilation included)."""
     model = jg.EHLModel(n_nodes=n, mixed="deterministic")
     t0 = time.perf_counter()
-    sol = jg.solve_ehl(contact, LUB, model, surf, displacement=jnp.zeros(2))
+    sol = jg.solve_ehl(contact, lub, model, surf, displacement=jnp.zeros(2))
     jax.block_until_ready(sol.p)
-    wall = time.perf_counter() - t0
+    return sol, time.perf_counter() - t0
+
+
+def add_cutoffs(ap, default_um):
+    """The ``--cutoffs`` option (short-wave cutoffs λs in µm, 0 for the unfiltered profile)."""
+    ap.add_argument(
+        "--cutoffs",
+        type=float,
+        nargs="+",
+        default=default_um,
+        help="short-wave cutoffs λs, µm (0: the unfiltered profile)",
+    )
+
+
+def _row(label, surf, n, rpm):
+    contact = gear_contact(rpm=rpm)
+    sol, wall = timed_solve(contact, LUB, surf, n)
     x = sol.x
     dx = float(x[1] - x[0])
     ph = float(contact.hertz_pressure)
@@ -91,13 +108,7 @@ def _row(label, surf, n, rpm):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--nodes", type=int, nargs="+", default=[257, 513, 1025, 2049])
-    ap.add_argument(
-        "--cutoffs",
-        type=float,
-        nargs="+",
-        default=[0.0, CUTOFF * 1e6],
-        help="short-wave cutoffs λs, µm (0: the unfiltered profile)",
-    )
+    add_cutoffs(ap, [0.0, CUTOFF * 1e6])
     ap.add_argument(
         "--sine-amplitude",
         type=float,
