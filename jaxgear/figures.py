@@ -190,7 +190,9 @@ def reproduce_paper(
         mode: "continuation" (the paper's stepwise speed increase; default) or "parallel" (default
             when ``quick``) for the tribo-dynamic sweeps.
         pair: GearPair (default ``presets.li2015_pair_calibrated()``); lubricant (default
-            ``presets.mil_l_23699()``). Surfaces: ``presets.ground()`` and ``presets.polished()``.
+            ``presets.mil_l_23699()``). Surfaces: ``presets.ground()`` and ``presets.polished()``
+            (Fig. 12 and R10 solve their contact with the same profiles filtered at the stylus
+            cutoff: ``field_surfaces``).
         checkpoint_dir: keep finished chunks here (one subdirectory per sweep) to resume.
         progress: progress bars on stderr.
 
