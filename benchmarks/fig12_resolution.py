@@ -51,13 +51,9 @@ def r10_contact(rpm: float):
     return figures.field_contact(repro, result, 0, i, slot), roll, repro.lubricant
 
 
-def _surfaces(kind: str, cutoff_um: float):
-    make = {"ground": jg.presets.ground, "polished": jg.presets.polished}[kind]
-    return make(short_cutoff=None if cutoff_um == 0.0 else cutoff_um * 1e-6)
-
-
 def _row(contact, lub, kind, cutoff_um, n):
-    sol, wall = timed_solve(contact, lub, _surfaces(kind, cutoff_um), n)
+    surf = figures.field_surfaces(kind, None if cutoff_um == 0.0 else cutoff_um * 1e-6)
+    sol, wall = timed_solve(contact, lub, surf, n)
     dx = float(sol.x[1] - sol.x[0])
     label = "unfiltered" if cutoff_um == 0.0 else f"λs = {cutoff_um:g} µm"
     row = (

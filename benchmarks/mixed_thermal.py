@@ -376,12 +376,14 @@ def _held_row(n, k, thermal, label, polished=False):
 
     import numpy as np
 
+    from jaxgear.figures import field_surfaces  # λs = 2.5 µm, the figures' stylus cutoff
+
     model = jg.EHLModel(n_nodes=n, mixed="deterministic", thermal=thermal)
     c = gear_contact(rpm=3500.0)
     dt = float(grid_time_step(c, LUB, model))
     contacts = jax.tree_util.tree_map(lambda a, k=k: jnp.full((k,), a), c)
     times = jnp.arange(k) * dt
-    surf = jg.presets.polished(short_cutoff=2.5e-6) if polished else jg.presets.ground()
+    surf = field_surfaces("polished") if polished else jg.presets.ground()
     fn = jax.jit(lambda cs, t, model=model: solve_ehl_passage(cs, LUB, model, surf, times=t))
     t0 = time.perf_counter()
     jax.block_until_ready(fn(contacts, times).p)

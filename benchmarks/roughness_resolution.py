@@ -34,10 +34,11 @@ from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
+from jaxgear.figures import FIELD_SHORT_CUTOFF  # noqa: E402
 from jaxgear.lubrication import roughness as rough  # noqa: E402
 
 LUB = jg.presets.mil_l_23699()
-CUTOFF = 2.5e-6  # m, ISO 3274 λs for Ra 0.1-2 µm profiles (λc = 0.8 mm)
+CUTOFF = FIELD_SHORT_CUTOFF  # m, ISO 3274 λs for Ra 0.1-2 µm profiles (λc = 0.8 mm)
 FACE_WIDTH = 0.02  # m, the paper's pair
 
 

@@ -464,15 +464,15 @@ def field_contact(repro: PaperReproduction, result, index: int, i: int, slot: in
     )
 
 
-def field_surfaces(kind: str):
+def field_surfaces(kind: str, short_cutoff: float | None = FIELD_SHORT_CUTOFF):
     """The roughness profiles Fig. 12 and R10 put in the film: the runs' synthetic surfaces
     (``presets.ground()`` / ``presets.polished()``: the same seed, Rq and correlation length) as a
-    stylus instrument measures them, band-limited at λs = FIELD_SHORT_CUTOFF (see
-    FIELD_DETERMINISTIC_NODES for why)."""
+    stylus instrument measures them, band-limited at λs = ``short_cutoff`` (m; default
+    FIELD_SHORT_CUTOFF, see FIELD_DETERMINISTIC_NODES for why; None: unfiltered)."""
     from . import presets
 
     make = {"ground": presets.ground, "polished": presets.polished}[kind]
-    return make(short_cutoff=FIELD_SHORT_CUTOFF)
+    return make(short_cutoff=short_cutoff)
 
 
 def _solve_contact(repro, result, index, i, slot, label, deterministic=False):
