@@ -19,12 +19,14 @@ each grid of ``--nodes``, the time step tied to each grid (Δt = Δx/ur: twice t
 nodes), at 500 and 3500 rpm: how its cost and loss move towards the issue's Δx ≤ 1 µm. Writes the
 ``mixed_engagement_grid`` section.
 
-``--held-steps K [--thermal] [--polished] [--rows FILE]``: the deterministic passage's cost a
-step on each grid of ``--nodes`` (K steps of the held pitch-point contact, 3500 rpm, iso-thermal or
-with ``--thermal`` the thermal passage; ``--polished``: the polished surfaces filtered at λs = 2.5
-µm, a full film), and the engagement it implies, where the whole engagement is out of reach (2049
-nodes: Δx 0.78 µm, the issue's ≤ 1 µm). ``--rows`` keeps the rows of all these
-passages in one table across runs. Writes the ``mixed_held_steps`` section.
+``--held-steps K [--thermal] [--polished] [--krylov] [--sweeps S] [--rows FILE]``: the
+deterministic passage's cost a step on each grid of ``--nodes`` (K steps of the held pitch-point
+contact, 3500 rpm, iso-thermal or with ``--thermal`` the thermal passage; ``--polished``: the
+polished surfaces filtered at λs = 2.5 µm, a full film; ``--krylov``: GMRES Newton directions
+instead of the dense LU; ``--sweeps``: the warm starts' relaxation sweeps), and the engagement it
+implies, where the whole engagement is out of reach (2049 nodes: Δx 0.78 µm, the issue's ≤ 1 µm).
+``--rows`` keeps the rows of all these passages in one table across runs. Writes the
+``mixed_held_steps`` section.
 
 ``--passage-iterations``: where the deterministic passage spends its time: the Newton iterations
 of each step (all attempts) with the warm-start budget of the default model (12) and with 60, at
@@ -93,6 +95,18 @@ def main(argv=None):
         help="with --held-steps: the polished surfaces filtered at the stylus cutoff λs = 2.5 µm "
         "(a full film) instead of the ground ones",
     )
+    ap.add_argument(
+        "--krylov",
+        action="store_true",
+        help='with --held-steps: EHLModel(linear_solver="krylov"), GMRES Newton directions on '
+        "grids from 1025 nodes instead of the dense LU",
+    )
+    ap.add_argument(
+        "--sweeps",
+        type=int,
+        default=None,
+        help="with --held-steps: EHLModel.relaxation_sweeps (default: the model's)",
+    )
     ap.add_argument("--rows", type=Path, help=ROWS_HELP + " (--held-steps)")
     args = ap.parse_args(argv)
     if args.engagement:
@@ -101,7 +115,13 @@ def main(argv=None):
         return engagement_grid(args.nodes)
     if args.held_steps:
         return held_steps(
-            args.nodes, args.held_steps, args.thermal, RowCache(args.rows), args.polished
+            args.nodes,
+            args.held_steps,
+            args.thermal,
+            RowCache(args.rows),
+            args.polished,
+            args.krylov,
+            args.sweeps,
         )
     if args.passage_iterations:
         return passage_iterations(args.steps)
@@ -353,32 +373,39 @@ def engagement_grid(sizes):
     write_section("mixed_engagement_grid", body)
 
 
-def held_steps(sizes, k, thermal, cache, polished=False):
+def held_steps(sizes, k, thermal, cache, polished=False, krylov=False, sweeps=None):
     """The deterministic passage's cost a step on finer grids, where a whole engagement is out of
     reach: k steps of the held pitch-point contact (3500 rpm, iso-thermal or thermal, Δt = Δx/ur),
     the compiled passage called twice; the time of a step from the second call's time per Newton
     iteration and each step's iterations (the first, steady, solve left out). Rows kept in
     ``cache`` (``--rows``) so that iso-thermal and thermal runs share one table. ``polished``: the
-    polished surfaces filtered at λs = 2.5 µm (a full film) instead of the ground ones."""
+    polished surfaces filtered at λs = 2.5 µm (a full film) instead of the ground ones. ``krylov``:
+    the GMRES Newton directions (``EHLModel.linear_solver``); ``sweeps``: the relaxation sweeps of
+    each warm start (None: the model's default)."""
     label = "thermal" if thermal else "iso-thermal"
     label += ", polished (λs 2.5 µm)" if polished else ""
-    group = int(thermal) + (2 if polished else 0)
+    label += ", Krylov" if krylov else ""
+    label += f", {sweeps} sweeps" if sweeps is not None else ""
+    group = int(thermal) + (2 if polished else 0) + (4 if krylov else 0)
+    group += 0 if sweeps is None else 8 * (sweeps + 1)
+    kw = {"linear_solver": "krylov"} if krylov else {}
+    kw |= {} if sweeps is None else {"relaxation_sweeps": sweeps}
     for n in sizes:
-        cache.get(f"{group} {n}", lambda n=n: _held_row(n, k, thermal, label, polished))
+        cache.get(f"{group} {n}", lambda n=n: _held_row(n, k, thermal, label, polished, **kw))
     rows = [
         cache.saved[key] for key in sorted(cache.saved, key=lambda s: tuple(map(int, s.split())))
     ]
     _write_held(rows, k)
 
 
-def _held_row(n, k, thermal, label, polished=False):
+def _held_row(n, k, thermal, label, polished=False, **model_options):
     import time
 
     import numpy as np
 
     from jaxgear.figures import field_surfaces  # λs = 2.5 µm, the figures' stylus cutoff
 
-    model = jg.EHLModel(n_nodes=n, mixed="deterministic", thermal=thermal)
+    model = jg.EHLModel(n_nodes=n, mixed="deterministic", thermal=thermal, **model_options)
     c = gear_contact(rpm=3500.0)
     dt = float(grid_time_step(c, LUB, model))
     contacts = jax.tree_util.tree_map(lambda a, k=k: jnp.full((k,), a), c)
