@@ -154,8 +154,8 @@ class EHLModel(eqx.Module):
         warm_iterations: Newton iterations allowed for a warm start before falling back to a cold
         solve.
         deformation: "dense", "fft" (DC-FFT for residuals; the Jacobian stays dense), "auto" (fft
-        above
-            1025 nodes).
+            above 1025 nodes). Grids that take Krylov directions (``linear_solver``) always use
+            DC-FFT.
         wedge_order: upwind order of the wedge term (1 or 2).
         thermal: thermal EHL (REFERENCE §5): the film's mean temperature (paper Eq. 8 profile, with
             convection) and both surface temperatures (Jaeger, paper Eq. 9) from the heat flux of
