@@ -334,34 +334,47 @@ def engagement():
     write_section("mixed_engagement", body)
 
 
-def engagement_grid(sizes):
-    """The deterministic passage along the path (iso-thermal, ground, 700 N m) on each grid:
-    compile and run time, converged steps, Newton iterations (all attempts, summed over the
-    steps) and the mean loss over the converged steps."""
+def _march_path(model, rpm, surf):
+    """One engagement along the path (``_path_contacts``) with ``model``, compiled then run:
+    (steps, compile s, run s, solutions, converged, iterations, mean loss over the converged
+    steps in W over the 20 mm face width, x at mid-engagement)."""
     import time
 
     import numpy as np
 
+    contacts, times, _ = _path_contacts(rpm, model)
+    k = times.shape[0]
+    fn = jax.jit(lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t))
+    t0 = time.perf_counter()
+    compiled = fn.lower(contacts, times).compile()
+    t_compile = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    sols = jax.block_until_ready(compiled(contacts, times))
+    t_run = time.perf_counter() - t0
+    ok = np.asarray(sols.converged)
+    loss = float(np.sum(np.where(ok, sols.power_loss, 0.0)) / max(ok.sum(), 1)) * 0.02
+    return (
+        k,
+        t_compile,
+        t_run,
+        sols,
+        ok,
+        np.asarray(sols.iterations),
+        loss,
+        np.asarray(sols.x[k // 2]),
+    )
+
+
+def engagement_grid(sizes):
+    """The deterministic passage along the path (iso-thermal, ground, 700 N m) on each grid:
+    compile and run time, converged steps, Newton iterations (all attempts, summed over the
+    steps) and the mean loss over the converged steps."""
     surf = jg.presets.ground()
     rows = []
     for rpm in (3500.0, 500.0):
         for n in sizes:
             model = jg.EHLModel(n_nodes=n, mixed="deterministic")
-            contacts, times, _ = _path_contacts(rpm, model)
-            k = times.shape[0]
-            fn = jax.jit(
-                lambda cs, t, model=model: solve_ehl_passage(cs, LUB, model, surf, times=t)
-            )
-            t0 = time.perf_counter()
-            compiled = fn.lower(contacts, times).compile()
-            t_compile = time.perf_counter() - t0
-            t0 = time.perf_counter()
-            sols = jax.block_until_ready(compiled(contacts, times))
-            t_run = time.perf_counter() - t0
-            ok = np.asarray(sols.converged)
-            its = np.asarray(sols.iterations)
-            loss = float(np.sum(np.where(ok, sols.power_loss, 0.0)) / ok.sum()) * 0.02
-            x_mid = np.asarray(sols.x[k // 2])
+            k, t_compile, t_run, sols, ok, its, loss, x_mid = _march_path(model, rpm, surf)
             rows.append(
                 f"| {n} | {(x_mid[1] - x_mid[0]) * 1e6:.2f} | {rpm:.0f} | {k} | {t_compile:.0f} | {t_run:.1f} | "
                 f"{t_run / k * 1e3:.0f} | {int(ok.sum())} of {k} | {int(its.sum())} | "
@@ -391,7 +404,6 @@ def engagement_fine(sizes, rpms, cache, sweeps=None):
     """One whole engagement of the polished film (λs 2.5 µm, iso-thermal, 700 N m) marched along
     the path on the grids the roughness needs, with the Krylov Newton directions (and ``sweeps``
     relaxation sweeps): measured, not extrapolated from held steps. Rows kept in ``cache``."""
-    import time
 
     import numpy as np
 
@@ -402,19 +414,7 @@ def engagement_fine(sizes, rpms, cache, sweeps=None):
     def measure(n, rpm):
         kw = {} if sweeps is None else {"relaxation_sweeps": sweeps}
         model = jg.EHLModel(n_nodes=n, mixed="deterministic", linear_solver="krylov", **kw)
-        contacts, times, _ = _path_contacts(rpm, model)
-        k = times.shape[0]
-        fn = jax.jit(lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t))
-        t0 = time.perf_counter()
-        compiled = fn.lower(contacts, times).compile()
-        t_compile = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        sols = jax.block_until_ready(compiled(contacts, times))
-        t_run = time.perf_counter() - t0
-        ok = np.asarray(sols.converged)
-        its = np.asarray(sols.iterations)
-        loss = float(np.sum(np.where(ok, sols.power_loss, 0.0)) / max(ok.sum(), 1)) * 0.02
-        x_mid = np.asarray(sols.x[k // 2])
+        k, t_compile, t_run, sols, ok, its, loss, x_mid = _march_path(model, rpm, surf)
         row = (
             f"| {n} | {(x_mid[1] - x_mid[0]) * 1e6:.2f} | {rpm:.0f} | "
             f"{'default' if sweeps is None else sweeps} | {k} | {t_compile:.0f} | {t_run:.0f} | "
