@@ -828,7 +828,7 @@ _KRYLOV_BLOCK = 128  # nodes a block of the block-Jacobi preconditioner
 
 def _block_preconditioner(level: _Level, u, s):
     """Block-Jacobi factors of J, the preconditioner of ``_krylov_direction``: the LUs of J's
-    diagonal blocks of ``_KRYLOV_BLOCK`` nodes, and J's H0 column.
+    diagonal blocks of ``_KRYLOV_BLOCK`` nodes, and J's H0 column solved with them.
 
     J[i, j] = ∂F_i/∂P_j + Σ_k ∂F_i/∂H_{i+k} D[i + k, j]: the Reynolds stencil plus the film's
     response through the deformation. A block keeps both within its nodes: the local elastic
@@ -854,22 +854,29 @@ def _block_preconditioner(level: _Level, u, s):
         blocks = blocks + blocked(dp)[:, :, None] * (offset == -k)
     # the padding past the last node: identity rows
     blocks = blocks + blocked(jnp.zeros((n,), u.dtype), 1.0)[:, :, None] * (offset == 0)
-    return jax.scipy.linalg.lu_factor(blocks), sum(dhs)
+    lu = jax.scipy.linalg.lu_factor(blocks)
+    # B⁻¹c once per direction (every preconditioner application needs it)
+    return lu, _block_solve(lu, sum(dhs), n)
+
+
+def _block_solve(lu, v, n):
+    """B⁻¹v for the block diagonal B factorised in ``lu`` (v zero-padded to whole blocks)."""
+    count, size = lu[0].shape[:2]
+    padded = jnp.concatenate([v, jnp.zeros((count * size - n,), v.dtype)]).reshape(count, size)
+    return jax.scipy.linalg.lu_solve(lu, padded[..., None]).reshape(count * size)[:n]
 
 
 def _bordered_solve(level: _Level, factors, v):
     """z with [B c; r 0] z = v: B the block diagonal of ``_block_preconditioner``, c the H0 column,
-    r the load row (Δ/(π/2) at every node), by block solves and the Schur complement."""
-    n, size = level.n, _KRYLOV_BLOCK
-    count = -(-n // size)
-    lu, column = factors
-    rhs = jnp.stack([v[:n], column], 1)
-    rhs = jnp.concatenate([rhs, jnp.zeros((count * size - n, 2), v.dtype)]).reshape(count, size, 2)
-    both = jax.scipy.linalg.lu_solve(lu, rhs).reshape(count * size, 2)[:n].T
+    r the load row (Δ/(π/2) at every node), by a block solve and the Schur complement (B⁻¹c comes
+    with the factors)."""
+    n = level.n
+    lu, column_solved = factors
+    y = _block_solve(lu, v[:n], n)
     row = level.spacing / (0.5 * jnp.pi)
-    schur = row * jnp.sum(both[1])
-    xi = (row * jnp.sum(both[0]) - v[n]) / jnp.where(schur != 0.0, schur, 1.0)
-    return jnp.concatenate([both[0] - xi * both[1], xi[None]])
+    schur = row * jnp.sum(column_solved)
+    xi = (row * jnp.sum(y) - v[n]) / jnp.where(schur != 0.0, schur, 1.0)
+    return jnp.concatenate([y - xi * column_solved, xi[None]])
 
 
 def _krylov_direction(level: _Level, u, s, f):
