@@ -529,17 +529,19 @@ def test_passage_time_step_convergence_is_first_order():
     b = float(c.hertz_half_width)
     dt = float(grid_time_step(c, LUB, model))
     surf = _bump_surfaces(b)
-    # 48 base steps carry the bump from −2.5 b to about the Hertz centre
+    # 24 base steps Δt = Δx/ur carry the bump from −2.5 b into the inlet of the Hertz zone, at
+    # Δt/2, Δt/4, Δt/8 (from Δt itself the step is outside the asymptotic range: the ratio below
+    # is 2.3 there, where first order gives 2.33 and second 4.2 against Δt/8, no discrimination)
     fields = []
-    for refine in (1, 2, 4):
-        sols = _passage(model, c, surf, dt / refine, 48 * refine + 1)
+    for refine in (2, 4, 8):
+        sols = _passage(model, c, surf, dt / refine, 24 * refine + 1)
         assert bool(jnp.all(sols.converged))
         fields.append(np.asarray(sols.h[-1]))
-    e1 = np.max(np.abs(fields[0] - fields[2]))
-    e2 = np.max(np.abs(fields[1] - fields[2]))
-    # backward Euler, first order: against the Δt/4 solution, (1 − 1/4)/(1/2 − 1/4) = 3
-    # (second order would give 5); the band allows for the pre-asymptotic range
-    assert 2.2 < e1 / e2 < 4.0, (e1, e2)
+    e2 = np.max(np.abs(fields[0] - fields[2]))
+    e4 = np.max(np.abs(fields[1] - fields[2]))
+    # backward Euler, first order: against the Δt/8 solution, (1/2 − 1/8)/(1/4 − 1/8) = 3
+    # (second order would give 5: tests/test_time_scheme.py, BDF2); measured 2.96
+    assert 2.2 < e2 / e4 < 4.0, (e2, e4)
 
 
 def test_thermal_passage_of_a_steady_state_reaches_the_steady_temperatures():

@@ -96,7 +96,10 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
     dt = jnp.maximum(t - t_prev, 1e-300)
     u_now = jnp.stack([contact.u1, contact.u2])
     d_prev = d
-    d = d + 0.5 * (u_prev + u_now) * (t - t_prev)
+    if not first:
+        # the first state is at ``times[0]``, where the surfaces stand at the given displacement
+        # (the carry's t_prev = times[0] − Δt0 only gives the first step a Δt to read)
+        d = d + 0.5 * (u_prev + u_now) * (t - t_prev)
     x = _grid_positions(model, contact, lubricant)
     dx = x[1] - x[0]
     inlet = contact.inlet_temperature
