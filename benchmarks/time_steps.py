@@ -1,0 +1,141 @@
+"""The transient passage's time step and time scheme against a rough film's friction (issue 4).
+
+A deterministic rough film's roughness moves through the contact with the surfaces; with the time
+step tied to the grid (Δt = Δx/ur, EHL_NOTES) the shortest roughness wavelength the grid resolves
+passes a node in a few steps, so the squeeze term's truncation error need not be small. This
+measures it: the pitch-point contact held (700 N m, slide-to-roll 0.3, 3500 rpm, iso-thermal), the
+polished surfaces filtered at λs = 2.5 µm (a full film: `figures.field_surfaces("polished")`),
+`EHLModel(mixed="deterministic", linear_solver="krylov", relaxation_sweeps=0)`, marched from a
+steady start over the same rolling distance (40 cells of the 2049-node grid, 31 µm) with
+Δt = C Δx/ur, C the Courant number, by backward Euler and by BDF2 (`EHLModel.time_scheme`), on
+1025, 2049 and 4097 nodes. Reported: the loss per width at the window's end (the roughness then
+stands at the same place in every run), the mean over the window's second half, p_max and h_min
+at the end, and the cost. Writes the ``mixed_time_steps`` section of benchmarks/RESULTS.md.
+
+Run: ``python benchmarks/time_steps.py [--rows FILE]`` (``--rows`` keeps measured rows across runs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+import jax.numpy as jnp  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
+
+from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
+from ehl_cases import gear_contact  # noqa: E402
+
+import jaxgear as jg  # noqa: E402
+from jaxgear.figures import field_surfaces  # noqa: E402
+from jaxgear.lubrication.passage import grid_time_step, solve_ehl_passage  # noqa: E402
+
+LUB = jg.presets.mil_l_23699()
+WINDOW_CELLS_2049 = 40  # the rolling distance, in cells of the 2049-node grid
+
+# (nodes, scheme, Courant numbers)
+RUNS = (
+    (2049, "backward_euler", (4.0, 2.0, 1.0, 0.5, 0.25)),
+    (2049, "bdf2", (4.0, 2.0, 1.0, 0.5, 0.25)),
+    (1025, "backward_euler", (1.0,)),
+    (1025, "bdf2", (1.0, 0.5, 0.25)),
+    (4097, "backward_euler", (1.0,)),
+    (4097, "bdf2", (1.0, 0.5)),
+)
+
+
+def measure(n, scheme, courant):
+    model = jg.EHLModel(
+        n_nodes=n,
+        mixed="deterministic",
+        linear_solver="krylov",
+        relaxation_sweeps=0,
+        time_scheme=scheme,
+    )
+    c = gear_contact(rpm=3500.0)
+    dt = courant * float(grid_time_step(c, LUB, model))
+    # the same rolling distance on every grid: 40 cells of 2049 nodes = 40 (n − 1)/2048 of n
+    steps = round(WINDOW_CELLS_2049 * (n - 1) / 2048 / courant)
+    k = steps + 1
+    contacts = jax.tree_util.tree_map(lambda a: jnp.full((k,), a), c)
+    times = jnp.arange(k) * dt
+    surf = field_surfaces("polished")
+    fn = jax.jit(lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t))
+    t0 = time.perf_counter()
+    compiled = fn.lower(contacts, times).compile()
+    t_compile = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    sol = jax.block_until_ready(compiled(contacts, times))
+    t_run = time.perf_counter() - t0
+    loss = np.asarray(sol.power_loss) / 1e3  # kW/m
+    its = np.asarray(sol.iterations)
+    ok = np.asarray(sol.converged)
+    dx = float(sol.x[0, 1] - sol.x[0, 0])
+    row = {
+        "nodes": n,
+        "dx_um": dx * 1e6,
+        "scheme": scheme,
+        "courant": courant,
+        "steps": steps,
+        "compile_s": t_compile,
+        "run_s": t_run,
+        "its": float(its[1:].mean()),
+        "converged": int(ok[1:].sum()),
+        "loss_end": float(loss[-1]),
+        "loss_half": float(loss[k // 2 :].mean()),
+        "p_max": float(np.max(np.asarray(sol.p[-1]))) / 1e9,
+        "h_min": float(np.asarray(sol.h_min)[-1]) * 1e6,
+    }
+    print(row, flush=True)
+    return row
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rows", type=Path, help=ROWS_HELP)
+    args = ap.parse_args(argv)
+    cache = RowCache(args.rows)
+    rows = []
+    for n, scheme, courants in RUNS:
+        for courant in courants:
+            key = f"{n} {scheme} {courant}"
+            rows.append(cache.get(key, lambda n=n, s=scheme, c=courant: measure(n, s, c)))
+    table = [
+        f"| {r['nodes']} | {r['dx_um']:.2f} | {r['scheme'].replace('_', ' ')} | {r['courant']:g} | "
+        f"{r['steps']} | {r['compile_s']:.0f} | {r['run_s']:.1f} | {r['its']:.1f} | "
+        f"{r['converged']} of {r['steps']} | {r['p_max']:.3f} | {r['h_min']:.4f} | "
+        f"{r['loss_end']:.2f} | {r['loss_half']:.2f} |"
+        for r in rows
+    ]
+    body = "\n".join(
+        [
+            "## A rough film's friction against the time step (`time_steps.py`, issue 4)",
+            "",
+            f"Machine: {machine()}. The pitch-point contact held (700 N m, SRR 0.3, 3500 rpm), "
+            "polished surfaces filtered at λs = 2.5 µm (a full film), iso-thermal, "
+            '`EHLModel(mixed="deterministic", linear_solver="krylov", relaxation_sweeps=0)`, '
+            "marched from a steady start over 31 µm of rolling (40 cells of the 2049-node grid) "
+            "with Δt = C Δx/ur. Loss per width at the window's end (the roughness at the same "
+            "place in every run) and its mean over the window's second half; p_max and h_min at "
+            "the end; its: Newton iterations a step (steps 1…).",
+            "",
+            "| nodes | Δx, µm | scheme | C | steps | compile, s | run, s | its a step | "
+            "converged | p_max, GPa | h_min, µm | loss at the end, kW/m | loss, 2nd half, kW/m |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            *table,
+        ]
+    )
+    write_section("mixed_time_steps", body)
+
+
+if __name__ == "__main__":
+    main()
