@@ -28,10 +28,10 @@ implies, where the whole engagement is out of reach (2049 nodes: Δx 0.78 µm, t
 ``--rows`` keeps the rows of all these passages in one table across runs. Writes the
 ``mixed_held_steps`` section.
 
-``--engagement-fine [--rpm R ...] [--sweeps S] [--rows FILE]``: one whole engagement of the
-polished film (λs 2.5 µm) along the path on each grid of ``--nodes`` with
-``EHLModel(linear_solver="krylov")``, marched, not extrapolated. Writes the
-``mixed_engagement_fine`` section.
+``--engagement-fine [--rpm R ...] [--sweeps S] [--time-scheme S] [--courant C] [--rows FILE]``:
+one whole engagement of the polished film (λs 2.5 µm) along the path on each grid of ``--nodes``
+with ``EHLModel(linear_solver="krylov")``, by backward Euler or BDF2 at Δt = C Δx/ur, marched, not
+extrapolated. Writes the ``mixed_engagement_fine`` section.
 
 ``--passage-iterations``: where the deterministic passage spends its time: the Newton iterations
 of each step (all attempts) with the warm-start budget of the default model (12) and with 60, at
@@ -119,6 +119,17 @@ def main(argv=None):
         default=None,
         help="with --held-steps: EHLModel.relaxation_sweeps (default: the model's)",
     )
+    ap.add_argument(
+        "--time-scheme",
+        default="backward_euler",
+        help="with --engagement-fine: EHLModel.time_scheme (backward_euler, bdf2)",
+    )
+    ap.add_argument(
+        "--courant",
+        type=float,
+        default=1.0,
+        help="with --engagement-fine: the time step Δt = C Δx/ur (C = 1: one cell a step)",
+    )
     ap.add_argument("--rows", type=Path, help=ROWS_HELP + " (--held-steps)")
     args = ap.parse_args(argv)
     if args.engagement:
@@ -126,7 +137,14 @@ def main(argv=None):
     if args.engagement_grid:
         return engagement_grid(args.nodes)
     if args.engagement_fine:
-        return engagement_fine(args.nodes, args.rpm, RowCache(args.rows), args.sweeps)
+        return engagement_fine(
+            args.nodes,
+            args.rpm,
+            RowCache(args.rows),
+            args.sweeps,
+            args.time_scheme,
+            args.courant,
+        )
     if args.held_steps:
         return held_steps(
             args.nodes,
@@ -214,10 +232,10 @@ def _mib(nbytes):
     return nbytes / 2**20
 
 
-def _path_contacts(rpm, model):
+def _path_contacts(rpm, model, courant=1.0):
     """The contact states of one tooth pair's whole engagement on the paper's calibrated pair
-    (700 N m, 90 °C), quasi-static load sharing, at the time steps Δt = Δx/ur of the pitch-point
-    contact: (contacts, times, Δt)."""
+    (700 N m, 90 °C), quasi-static load sharing, at the time steps Δt = C Δx/ur of the pitch-point
+    contact (C = ``courant``): (contacts, times, Δt)."""
     import numpy as np
 
     from jaxgear.material import reduced_modulus
@@ -234,7 +252,7 @@ def _path_contacts(rpm, model):
     s_path, w_path = s_path[keep], w_path[keep]
     omega1 = rpm * 2.0 * np.pi / 60.0
     t_path = (s_path - s_path[0]) / (float(geo.base_radius[0]) * omega1)
-    dt = float(grid_time_step(gear_contact(rpm=rpm), LUB, model))
+    dt = courant * float(grid_time_step(gear_contact(rpm=rpm), LUB, model))
     times = np.arange(0.0, t_path[-1], dt)
     s_t = np.interp(times, t_path, s_path)
     kin = jg.kinematics(pair, geo, jnp.asarray(s_t), omega1)
@@ -334,7 +352,7 @@ def engagement():
     write_section("mixed_engagement", body)
 
 
-def _march_path(model, rpm, surf):
+def _march_path(model, rpm, surf, courant=1.0):
     """One engagement along the path (``_path_contacts``) with ``model``, compiled then run:
     (steps, compile s, run s, solutions, converged, iterations, mean loss over the converged
     steps in W over the 20 mm face width, x at mid-engagement)."""
@@ -342,7 +360,7 @@ def _march_path(model, rpm, surf):
 
     import numpy as np
 
-    contacts, times, _ = _path_contacts(rpm, model)
+    contacts, times, _ = _path_contacts(rpm, model, courant)
     k = times.shape[0]
     fn = jax.jit(lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t))
     t0 = time.perf_counter()
@@ -400,10 +418,11 @@ def engagement_grid(sizes):
     write_section("mixed_engagement_grid", body)
 
 
-def engagement_fine(sizes, rpms, cache, sweeps=None):
+def engagement_fine(sizes, rpms, cache, sweeps=None, scheme="backward_euler", courant=1.0):
     """One whole engagement of the polished film (λs 2.5 µm, iso-thermal, 700 N m) marched along
     the path on the grids the roughness needs, with the Krylov Newton directions (and ``sweeps``
-    relaxation sweeps): measured, not extrapolated from held steps. Rows kept in ``cache``."""
+    relaxation sweeps), by ``scheme`` (``EHLModel.time_scheme``) at Δt = ``courant`` Δx/ur:
+    measured, not extrapolated from held steps. Rows kept in ``cache``."""
 
     import numpy as np
 
@@ -413,22 +432,27 @@ def engagement_fine(sizes, rpms, cache, sweeps=None):
 
     def measure(n, rpm):
         kw = {} if sweeps is None else {"relaxation_sweeps": sweeps}
-        model = jg.EHLModel(n_nodes=n, mixed="deterministic", linear_solver="krylov", **kw)
-        k, t_compile, t_run, sols, ok, its, loss, x_mid = _march_path(model, rpm, surf)
+        model = jg.EHLModel(
+            n_nodes=n, mixed="deterministic", linear_solver="krylov", time_scheme=scheme, **kw
+        )
+        k, t_compile, t_run, sols, ok, its, loss, x_mid = _march_path(model, rpm, surf, courant)
         row = (
             f"| {n} | {(x_mid[1] - x_mid[0]) * 1e6:.2f} | {rpm:.0f} | "
-            f"{'default' if sweeps is None else sweeps} | {k} | {t_compile:.0f} | {t_run:.0f} | "
+            f"{'default' if sweeps is None else sweeps} | {scheme.replace('_', ' ')} | "
+            f"{courant:g} | {k} | {t_compile:.0f} | {t_run:.0f} | "
             f"{t_run / k * 1e3:.0f} | {int(ok.sum())} of {k} | {its[1:].mean():.1f} | "
             f"{float(np.max(np.asarray(sols.p))) / 1e9:.2f} | {loss:.0f} |"
         )
         print(row, flush=True)
         return row
 
-    rows = [
-        cache.get(f"{n} {rpm:.0f} {sweeps}", lambda n=n, rpm=rpm: measure(n, rpm))
-        for rpm in rpms
-        for n in sizes
-    ]
+    for rpm in rpms:
+        for n in sizes:
+            # rows of backward Euler at Δx/ur keep the keys they were measured under
+            key = f"{n} {rpm:.0f} {sweeps}"
+            key += "" if (scheme, courant) == ("backward_euler", 1.0) else f" {scheme} {courant:g}"
+            cache.get(key, lambda n=n, rpm=rpm: measure(n, rpm))
+    rows = list(cache.saved.values())
     body = "\n".join(
         [
             "## The polished engagement on the issue's grid, Krylov directions "
@@ -437,13 +461,14 @@ def engagement_fine(sizes, rpms, cache, sweeps=None):
             f"Machine: {machine()}. One engagement along the path of contact (as "
             "`mixed_engagement`), polished surfaces filtered at λs = 2.5 µm (a full film), 700 N m, "
             'iso-thermal, `EHLModel(mixed="deterministic", linear_solver="krylov")` with the '
-            "warm starts' relaxation sweeps given; Δt = Δx/ur of the pitch-point contact. Its: "
+            "warm starts' relaxation sweeps and the time scheme given; Δt = C Δx/ur of the "
+            "pitch-point contact. Its: "
             "Newton iterations a step (all attempts, steps 2…). Loss: the mean over the converged "
             "steps, over the 20 mm face width.",
             "",
-            "| nodes | Δx mid-engagement, µm | rpm | sweeps | steps | compile, s | run, s | "
-            "per step, ms | converged | its a step | max p, GPa | loss, W |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|",
+            "| nodes | Δx mid-engagement, µm | rpm | sweeps | scheme | C | steps | compile, s | "
+            "run, s | per step, ms | converged | its a step | max p, GPa | loss, W |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
             *rows,
         ]
     )

@@ -319,8 +319,8 @@ def _engagement_passage(
 
     In the periodic steady state every tooth pair has the same history, and one pair's engagement is
     slot 0 over a mesh period followed by slot 1 over the next (MeshCycle). The 2M states are marched
-    in that order by ``solve_ehl_passage`` (squeeze term ∂(ρh)/∂t by backward Euler with
-    Δt = period / M, surface temperatures with memory when thermal), and the solutions are put back
+    in that order by ``solve_ehl_passage`` (squeeze term ∂(ρh)/∂t by the model's
+    ``time_scheme``, backward Euler by default, with Δt = period / M, surface temperatures with memory when thermal), and the solutions are put back
     on the [M, 2] table. States out of contact are masked out by the caller; here they carry the
     nearest loaded state before them (the first loaded one before entry), so the march never jumps
     through a stand-in load and back, which would be a spurious squeeze.

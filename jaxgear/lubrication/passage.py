@@ -17,7 +17,7 @@ The time step is the caller's choice. Tied to the grid, Δt = Δx/ur moves the r
 cell per step (EHL_NOTES "Transient"); :func:`grid_time_step` gives it. Backward Euler is first
 order in Δt: halving Δt halves the time-discretisation error; BDF2 is second order (both tested).
 A roughness whose shortest wavelength spans a few cells passes a node in a few such steps, so a
-rough film's friction needs Δt below Δx/ur (RESULTS ``mixed_time_steps``)
+rough film's friction needs Δt below Δx/ur (RESULTS ``mixed_time_steps``).
 """
 
 from __future__ import annotations

@@ -6,7 +6,8 @@ equation
 d/dx(ρh³/(12η) dp/dx) = um d(ρh)/dx + ∂(ρh)/∂t becomes
 
     R(X) = d/dX(ε dP/dX) − d(ρ̄H)/dX − σ (ρ̄H − ρ̄H_prev) = 0,  ε = ρ̄H³/(η̄ λ̄),
-    λ̄ = 12 η0 um R²/(b³ ph),  σ = b/(um Δt)  (backward Euler; σ = 0 when steady).
+    λ̄ = 12 η0 um R²/(b³ ph),  σ = b/(um Δt)  (backward Euler; σ = 0 when steady; BDF2 is the same term with a scaled σ
+    and a blended ρ̄H_prev, ``passage._squeeze_history``).
 
 Finite volumes on a uniform grid: the Poiseuille term with ε at cell faces (arithmetic mean), the
 wedge
