@@ -8,7 +8,8 @@ polished surfaces filtered at λs = 2.5 µm (a full film: `figures.field_surface
 `EHLModel(mixed="deterministic", linear_solver="krylov", relaxation_sweeps=0)`, marched from a
 steady start over the same rolling distance (40 cells of the 2049-node grid, 31 µm) with
 Δt = C Δx/ur, C the Courant number, by backward Euler and by BDF2 (`EHLModel.time_scheme`), on
-1025, 2049 and 4097 nodes. Reported: the loss per width at the window's end (the roughness then
+1025, 2049 and 4097 nodes; and the ground surfaces (unfiltered) on the 257 nodes of the
+deterministic engagement (`mixed_engagement`). Reported: the loss per width at the window's end (the roughness then
 stands at the same place in every run), the mean over the window's second half, p_max and h_min
 at the end, and the cost. Writes the ``mixed_time_steps`` section of benchmarks/RESULTS.md.
 
@@ -42,33 +43,39 @@ from jaxgear.lubrication.passage import grid_time_step, solve_ehl_passage  # noq
 LUB = jg.presets.mil_l_23699()
 WINDOW_CELLS_2049 = 40  # the rolling distance, in cells of the 2049-node grid
 
-# (nodes, scheme, Courant numbers)
+GROUND_WINDOW_CELLS_2049 = 320  # the ground film's: 40 cells of its 257-node grid (250 µm)
+
+# (film, nodes, scheme, Courant numbers)
 RUNS = (
-    (2049, "backward_euler", (4.0, 2.0, 1.0, 0.5, 0.25)),
-    (2049, "bdf2", (4.0, 2.0, 1.0, 0.5, 0.25)),
-    (1025, "backward_euler", (1.0,)),
-    (1025, "bdf2", (1.0, 0.5, 0.25)),
-    (4097, "backward_euler", (1.0,)),
-    (4097, "bdf2", (1.0, 0.5)),
+    ("polished", 2049, "backward_euler", (4.0, 2.0, 1.0, 0.5, 0.25)),
+    ("polished", 2049, "bdf2", (4.0, 2.0, 1.0, 0.5, 0.25)),
+    ("polished", 1025, "backward_euler", (1.0,)),
+    ("polished", 1025, "bdf2", (1.0, 0.5, 0.25)),
+    ("polished", 4097, "backward_euler", (1.0,)),
+    ("polished", 4097, "bdf2", (1.0, 0.5)),
+    ("ground", 257, "backward_euler", (1.0, 0.5, 0.25)),
+    ("ground", 257, "bdf2", (1.0, 0.5, 0.25)),
 )
 
 
-def measure(n, scheme, courant):
-    model = jg.EHLModel(
-        n_nodes=n,
-        mixed="deterministic",
-        linear_solver="krylov",
-        relaxation_sweeps=0,
-        time_scheme=scheme,
-    )
+def measure(film, n, scheme, courant):
+    # the polished full film: Krylov directions, unrelaxed warm starts (as --engagement-fine);
+    # the ground film on 257 nodes: the default deterministic model (dense LU, relaxed starts)
+    if film == "polished":
+        options = {"linear_solver": "krylov", "relaxation_sweeps": 0}
+        window = WINDOW_CELLS_2049
+    else:
+        options = {}
+        window = GROUND_WINDOW_CELLS_2049
+    model = jg.EHLModel(n_nodes=n, mixed="deterministic", time_scheme=scheme, **options)
     c = gear_contact(rpm=3500.0)
     dt = courant * float(grid_time_step(c, LUB, model))
-    # the same rolling distance on every grid: 40 cells of 2049 nodes = 40 (n − 1)/2048 of n
-    steps = round(WINDOW_CELLS_2049 * (n - 1) / 2048 / courant)
+    # the same rolling distance on every grid: w cells of 2049 nodes = w (n − 1)/2048 of n
+    steps = round(window * (n - 1) / 2048 / courant)
     k = steps + 1
     contacts = jax.tree_util.tree_map(lambda a: jnp.full((k,), a), c)
     times = jnp.arange(k) * dt
-    surf = field_surfaces("polished")
+    surf = field_surfaces("polished") if film == "polished" else jg.presets.ground()
     fn = jax.jit(lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t))
     t0 = time.perf_counter()
     compiled = fn.lower(contacts, times).compile()
@@ -81,6 +88,7 @@ def measure(n, scheme, courant):
     ok = np.asarray(sol.converged)
     dx = float(sol.x[0, 1] - sol.x[0, 0])
     row = {
+        "film": film,
         "nodes": n,
         "dx_um": dx * 1e6,
         "scheme": scheme,
@@ -105,12 +113,15 @@ def main(argv=None):
     args = ap.parse_args(argv)
     cache = RowCache(args.rows)
     rows = []
-    for n, scheme, courants in RUNS:
+    for film, n, scheme, courants in RUNS:
         for courant in courants:
-            key = f"{n} {scheme} {courant}"
-            rows.append(cache.get(key, lambda n=n, s=scheme, c=courant: measure(n, s, c)))
+            # the polished rows keep the keys they were first measured under
+            key = f"{n} {scheme} {courant}" + ("" if film == "polished" else f" {film}")
+            rows.append(
+                cache.get(key, lambda f=film, n=n, s=scheme, c=courant: measure(f, n, s, c))
+            )
     table = [
-        f"| {r['nodes']} | {r['dx_um']:.2f} | {r['scheme'].replace('_', ' ')} | {r['courant']:g} | "
+        f"| {r.get('film', 'polished')} | {r['nodes']} | {r['dx_um']:.2f} | {r['scheme'].replace('_', ' ')} | {r['courant']:g} | "
         f"{r['steps']} | {r['compile_s']:.0f} | {r['run_s']:.1f} | {r['its']:.1f} | "
         f"{r['converged']} of {r['steps']} | {r['p_max']:.3f} | {r['h_min']:.4f} | "
         f"{r['loss_end']:.2f} | {r['loss_half']:.2f} |"
@@ -121,16 +132,17 @@ def main(argv=None):
             "## A rough film's friction against the time step (`time_steps.py`, issue 4)",
             "",
             f"Machine: {machine()}. The pitch-point contact held (700 N m, SRR 0.3, 3500 rpm), "
-            "polished surfaces filtered at λs = 2.5 µm (a full film), iso-thermal, "
+            "iso-thermal. Polished: the surfaces filtered at λs = 2.5 µm (a full film), "
             '`EHLModel(mixed="deterministic", linear_solver="krylov", relaxation_sweeps=0)`, '
-            "marched from a steady start over 31 µm of rolling (40 cells of the 2049-node grid) "
-            "with Δt = C Δx/ur. Loss per width at the window's end (the roughness at the same "
+            "marched from a steady start over 31 µm of rolling (40 cells of the 2049-node grid). "
+            "Ground: the ground preset (unfiltered) on 257 nodes, the default deterministic "
+            "`EHLModel`, over 250 µm (40 of its cells). Δt = C Δx/ur. Loss per width at the window's end (the roughness at the same "
             "place in every run) and its mean over the window's second half; p_max and h_min at "
             "the end; its: Newton iterations a step (steps 1…).",
             "",
-            "| nodes | Δx, µm | scheme | C | steps | compile, s | run, s | its a step | "
+            "| film | nodes | Δx, µm | scheme | C | steps | compile, s | run, s | its a step | "
             "converged | p_max, GPa | h_min, µm | loss at the end, kW/m | loss, 2nd half, kW/m |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
             *table,
         ]
     )
