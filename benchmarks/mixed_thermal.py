@@ -28,7 +28,8 @@ implies, where the whole engagement is out of reach (2049 nodes: Δx 0.78 µm, t
 ``--rows`` keeps the rows of all these passages in one table across runs. Writes the
 ``mixed_held_steps`` section.
 
-``--engagement-fine [--rpm R ...] [--sweeps S] [--time-scheme S] [--courant C] [--rows FILE]``:
+``--engagement-fine [--rpm R ...] [--sweeps S] [--time-scheme S] [--courant C] [--tolerance T]
+[--rows FILE]``:
 one whole engagement of the polished film (λs 2.5 µm) along the path on each grid of ``--nodes``
 with ``EHLModel(linear_solver="krylov")``, by backward Euler or BDF2 at Δt = C Δx/ur, marched, not
 extrapolated. Writes the ``mixed_engagement_fine`` section.
@@ -130,6 +131,12 @@ def main(argv=None):
         default=1.0,
         help="with --engagement-fine: the time step Δt = C Δx/ur (C = 1: one cell a step)",
     )
+    ap.add_argument(
+        "--tolerance",
+        type=float,
+        default=1e-9,
+        help="with --engagement-fine: EHLModel.tolerance, the Newton solves' ‖F‖∞",
+    )
     ap.add_argument("--rows", type=Path, help=ROWS_HELP + " (--held-steps)")
     args = ap.parse_args(argv)
     if args.engagement:
@@ -144,6 +151,7 @@ def main(argv=None):
             args.sweeps,
             args.time_scheme,
             args.courant,
+            args.tolerance,
         )
     if args.held_steps:
         return held_steps(
@@ -418,11 +426,14 @@ def engagement_grid(sizes):
     write_section("mixed_engagement_grid", body)
 
 
-def engagement_fine(sizes, rpms, cache, sweeps=None, scheme="backward_euler", courant=1.0):
+def engagement_fine(
+    sizes, rpms, cache, sweeps=None, scheme="backward_euler", courant=1.0, tolerance=1e-9
+):
     """One whole engagement of the polished film (λs 2.5 µm, iso-thermal, 700 N m) marched along
     the path on the grids the roughness needs, with the Krylov Newton directions (and ``sweeps``
-    relaxation sweeps), by ``scheme`` (``EHLModel.time_scheme``) at Δt = ``courant`` Δx/ur:
-    measured, not extrapolated from held steps. Rows kept in ``cache``."""
+    relaxation sweeps), by ``scheme`` (``EHLModel.time_scheme``) at Δt = ``courant`` Δx/ur, the
+    Newton solves to ``tolerance``: measured, not extrapolated from held steps. Rows kept in
+    ``cache``."""
 
     import numpy as np
 
@@ -433,13 +444,18 @@ def engagement_fine(sizes, rpms, cache, sweeps=None, scheme="backward_euler", co
     def measure(n, rpm):
         kw = {} if sweeps is None else {"relaxation_sweeps": sweeps}
         model = jg.EHLModel(
-            n_nodes=n, mixed="deterministic", linear_solver="krylov", time_scheme=scheme, **kw
+            n_nodes=n,
+            mixed="deterministic",
+            linear_solver="krylov",
+            time_scheme=scheme,
+            tolerance=tolerance,
+            **kw,
         )
         k, t_compile, t_run, sols, ok, its, loss, x_mid = _march_path(model, rpm, surf, courant)
         row = (
             f"| {n} | {(x_mid[1] - x_mid[0]) * 1e6:.2f} | {rpm:.0f} | "
             f"{'default' if sweeps is None else sweeps} | {scheme.replace('_', ' ')} | "
-            f"{courant:g} | {k} | {t_compile:.0f} | {t_run:.0f} | "
+            f"{courant:g} | {tolerance:g} | {k} | {t_compile:.0f} | {t_run:.0f} | "
             f"{t_run / k * 1e3:.0f} | {int(ok.sum())} of {k} | {its[1:].mean():.1f} | "
             f"{float(np.max(np.asarray(sols.p))) / 1e9:.2f} | {loss:.0f} |"
         )
@@ -451,6 +467,7 @@ def engagement_fine(sizes, rpms, cache, sweeps=None, scheme="backward_euler", co
             # rows of backward Euler at Δx/ur keep the keys they were measured under
             key = f"{n} {rpm:.0f} {sweeps}"
             key += "" if (scheme, courant) == ("backward_euler", 1.0) else f" {scheme} {courant:g}"
+            key += "" if tolerance == 1e-9 else f" tol {tolerance:g}"
             cache.get(key, lambda n=n, rpm=rpm: measure(n, rpm))
     rows = list(cache.saved.values())
     body = "\n".join(
@@ -461,14 +478,14 @@ def engagement_fine(sizes, rpms, cache, sweeps=None, scheme="backward_euler", co
             f"Machine: {machine()}. One engagement along the path of contact (as "
             "`mixed_engagement`), polished surfaces filtered at λs = 2.5 µm (a full film), 700 N m, "
             'iso-thermal, `EHLModel(mixed="deterministic", linear_solver="krylov")` with the '
-            "warm starts' relaxation sweeps and the time scheme given; Δt = C Δx/ur of the "
-            "pitch-point contact. Its: "
+            "warm starts' relaxation sweeps, the time scheme and the Newton tolerance given; "
+            "Δt = C Δx/ur of the pitch-point contact. Its: "
             "Newton iterations a step (all attempts, steps 2…). Loss: the mean over the converged "
             "steps, over the 20 mm face width.",
             "",
-            "| nodes | Δx mid-engagement, µm | rpm | sweeps | scheme | C | steps | compile, s | "
-            "run, s | per step, ms | converged | its a step | max p, GPa | loss, W |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            "| nodes | Δx mid-engagement, µm | rpm | sweeps | scheme | C | tolerance | steps | "
+            "compile, s | run, s | per step, ms | converged | its a step | max p, GPa | loss, W |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
             *rows,
         ]
     )
