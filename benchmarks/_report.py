@@ -57,6 +57,19 @@ class RowCache:
         return self.saved[key]
 
 
+def compile_then_run(fn, *args):
+    """(result, compile s, run s): ``jax.jit(fn)`` lowered and compiled for ``args``, then called
+    once on them (compile and run timed apart: a long march is run once)."""
+    import jax
+
+    t0 = time.perf_counter()
+    compiled = jax.jit(fn).lower(*args).compile()
+    t_compile = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    result = jax.block_until_ready(compiled(*args))
+    return result, t_compile, time.perf_counter() - t0
+
+
 def time_call(fn, *args, repeats: int = 20):
     """(compile+first-run seconds, median run seconds) of ``fn(*args)`` with block_until_ready."""
     import jax

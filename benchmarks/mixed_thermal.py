@@ -54,7 +54,14 @@ import jax.numpy as jnp  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
-from _report import ROWS_HELP, RowCache, machine, time_call, write_section  # noqa: E402
+from _report import (  # noqa: E402
+    ROWS_HELP,
+    RowCache,
+    compile_then_run,
+    machine,
+    time_call,
+    write_section,
+)
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
@@ -364,19 +371,14 @@ def _march_path(model, rpm, surf, courant=1.0):
     """One engagement along the path (``_path_contacts``) with ``model``, compiled then run:
     (steps, compile s, run s, solutions, converged, iterations, mean loss over the converged
     steps in W over the 20 mm face width, x at mid-engagement)."""
-    import time
 
     import numpy as np
 
     contacts, times, _ = _path_contacts(rpm, model, courant)
     k = times.shape[0]
-    fn = jax.jit(lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t))
-    t0 = time.perf_counter()
-    compiled = fn.lower(contacts, times).compile()
-    t_compile = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    sols = jax.block_until_ready(compiled(contacts, times))
-    t_run = time.perf_counter() - t0
+    sols, t_compile, t_run = compile_then_run(
+        lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t), contacts, times
+    )
     ok = np.asarray(sols.converged)
     loss = float(np.sum(np.where(ok, sols.power_loss, 0.0)) / max(ok.sum(), 1)) * 0.02
     return (

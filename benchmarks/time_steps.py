@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import jax
@@ -34,7 +33,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
-from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
+from _report import ROWS_HELP, RowCache, compile_then_run, machine, write_section  # noqa: E402
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
@@ -82,13 +81,9 @@ def measure(film, n, scheme, courant, tolerance=1e-9):
     contacts = jax.tree_util.tree_map(lambda a: jnp.full((k,), a), c)
     times = jnp.arange(k) * dt
     surf = field_surfaces("polished") if film == "polished" else jg.presets.ground()
-    fn = jax.jit(lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t))
-    t0 = time.perf_counter()
-    compiled = fn.lower(contacts, times).compile()
-    t_compile = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    sol = jax.block_until_ready(compiled(contacts, times))
-    t_run = time.perf_counter() - t0
+    sol, t_compile, t_run = compile_then_run(
+        lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t), contacts, times
+    )
     loss = np.asarray(sol.power_loss) / 1e3  # kW/m
     its = np.asarray(sol.iterations)
     ok = np.asarray(sol.converged)

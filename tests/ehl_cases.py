@@ -86,3 +86,26 @@ def pan_hamrock(contact, lub):
     hmin = 1.714 * w**-0.128 * u**0.694 * g**0.568 * r
     hc = 2.922 * w**-0.166 * u**0.692 * g**0.470 * r
     return hmin, hc
+
+
+def bump_surfaces(b, amplitude=50e-9, width=10e-6, start=-2.5):
+    """One Gaussian bump (amplitude, 1/e half-width, m) on surface 1, entering from x = start·b."""
+    import jax.numpy as jnp
+
+    from jaxgear.lubrication.roughness import Surfaces
+
+    dx, n = 0.5e-6, 8192
+    xs = np.arange(n) * dx
+    z1 = amplitude * np.exp(-(((xs - (n * dx + start * b)) / width) ** 2))
+    return Surfaces(profile1=jnp.asarray(z1), profile2=jnp.zeros(n), dx=dx)
+
+
+def held_passage(model, contact, lub, surfaces, dt, k):
+    """``solve_ehl_passage`` of ``contact`` held for k states, Δt apart."""
+    import jax
+    import jax.numpy as jnp
+
+    from jaxgear.lubrication.passage import solve_ehl_passage
+
+    contacts = jax.tree_util.tree_map(lambda a: jnp.full((k,), a), contact)
+    return solve_ehl_passage(contacts, lub, model, surfaces, times=jnp.arange(k) * dt)

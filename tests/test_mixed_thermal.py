@@ -11,12 +11,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact
+from ehl_cases import bump_surfaces, gear_contact, held_passage
 
 import jaxgear as jg
 from jaxgear.lubrication import asperity
-from jaxgear.lubrication.passage import grid_time_step, solve_ehl_passage
-from jaxgear.lubrication.roughness import Surfaces, ground, polished
+from jaxgear.lubrication.passage import grid_time_step
+from jaxgear.lubrication.roughness import ground, polished
 from jaxgear.material import steel
 
 LUB = jg.presets.mil_l_23699()
@@ -481,18 +481,6 @@ def test_extremes_are_finite(rpm, slide, scale):
 # --------------------------------------------------------------------------------------------------
 # Transient passage
 # --------------------------------------------------------------------------------------------------
-def _bump_surfaces(b, amplitude=50e-9, width=10e-6, start=-2.5):
-    dx, n = 0.5e-6, 8192
-    xs = np.arange(n) * dx
-    z1 = amplitude * np.exp(-(((xs - (n * dx + start * b)) / width) ** 2))
-    return Surfaces(profile1=jnp.asarray(z1), profile2=jnp.zeros(n), dx=dx)
-
-
-def _passage(model, contact, surf, dt, k):
-    contacts = jax.tree_util.tree_map(lambda a: jnp.full((k,), a), contact)
-    return solve_ehl_passage(contacts, LUB, model, surf, times=jnp.arange(k) * dt)
-
-
 @pytest.mark.slow
 def test_passage_single_asperity_travels_with_its_surface():
     # pure rolling: the bump (on surface 1, entering from x = −2.5 b) is carried at u1; the
@@ -502,7 +490,7 @@ def test_passage_single_asperity_travels_with_its_surface():
     b = float(c.hertz_half_width)
     dt = float(grid_time_step(c, LUB, model))
     k = 48
-    sols = _passage(model, c, _bump_surfaces(b), dt, k)
+    sols = held_passage(model, c, LUB, bump_surfaces(b), dt, k)
     smooth = jg.solve_ehl(c, LUB, model)
     assert bool(jnp.all(sols.converged))
     assert _finite(sols)
@@ -522,28 +510,6 @@ def test_passage_single_asperity_travels_with_its_surface():
             assert dh.min() < -0.5 * 50e-9
 
 
-@pytest.mark.slow
-def test_passage_time_step_convergence_is_first_order():
-    model = jg.EHLModel(n_nodes=129, mixed="deterministic")
-    c = gear_contact(rpm=2000.0, slide_to_roll=0.3)
-    b = float(c.hertz_half_width)
-    dt = float(grid_time_step(c, LUB, model))
-    surf = _bump_surfaces(b)
-    # 24 base steps Δt = Δx/ur carry the bump from −2.5 b into the inlet of the Hertz zone, at
-    # Δt/2, Δt/4, Δt/8 (from Δt itself the step is outside the asymptotic range: the ratio below
-    # is 2.3 there, where first order gives 2.33 and second 4.2 against Δt/8, no discrimination)
-    fields = []
-    for refine in (2, 4, 8):
-        sols = _passage(model, c, surf, dt / refine, 24 * refine + 1)
-        assert bool(jnp.all(sols.converged))
-        fields.append(np.asarray(sols.h[-1]))
-    e2 = np.max(np.abs(fields[0] - fields[2]))
-    e4 = np.max(np.abs(fields[1] - fields[2]))
-    # backward Euler, first order: against the Δt/8 solution, (1/2 − 1/8)/(1/4 − 1/8) = 3
-    # (second order would give 5: tests/test_time_scheme.py, BDF2); measured 2.96
-    assert 2.2 < e2 / e4 < 4.0, (e2, e4)
-
-
 def test_thermal_passage_of_a_steady_state_reaches_the_steady_temperatures():
     # The transient surface temperatures (moving heat source with memory, paper Eq. 9, carried from
     # step to step) under a contact that does not change must settle on the steady solution's
@@ -554,7 +520,7 @@ def test_thermal_passage_of_a_steady_state_reaches_the_steady_temperatures():
     c = gear_contact(rpm=2000.0, slide_to_roll=1.0)
     steady = jg.solve_ehl(c, LUB, model)
     k, dt = 60, 0.25 * float(steady.hertz_half_width) / float(c.rolling_velocity)
-    sols = _passage(model, c, None, dt, k)
+    sols = held_passage(model, c, LUB, None, dt, k)
     assert bool(jnp.all(sols.converged))
     t_in = float(c.inlet_temperature)
     for field in ("surface_temperature1", "surface_temperature2"):
