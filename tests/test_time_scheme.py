@@ -1,5 +1,5 @@
-"""The transient passage's time scheme (``EHLModel.time_scheme``): backward Euler or BDF2 for the
-squeeze term ∂(ρh)/∂t (issue 4)."""
+"""The transient passage in time (issue 4): its time scheme (``EHLModel.time_scheme``, backward
+Euler or BDF2 for the squeeze term ∂(ρh)/∂t) and where its roughness stands at the first state."""
 
 import jax
 import jax.numpy as jnp
