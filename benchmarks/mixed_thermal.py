@@ -247,9 +247,9 @@ def _mib(nbytes):
     return nbytes / 2**20
 
 
-def _path_contacts(rpm, model, courant=1.0):
+def _path_contacts(rpm, model, courant=1.0, torque=700.0):
     """The contact states of one tooth pair's whole engagement on the paper's calibrated pair
-    (700 N m, 90 °C), quasi-static load sharing, at the time steps Δt = C Δx/ur of the pitch-point
+    (``torque``, 700 N m by default, 90 °C), quasi-static load sharing, at the time steps Δt = C Δx/ur of the pitch-point
     contact (C = ``courant``): (contacts, times, Δt)."""
     import numpy as np
 
@@ -257,7 +257,7 @@ def _path_contacts(rpm, model, courant=1.0):
 
     pair = jg.presets.li2015_pair_calibrated()
     m = 256
-    mc = jg.mesh_cycle(pair, 700.0, n_positions=m)
+    mc = jg.mesh_cycle(pair, torque, n_positions=m)
     geo = jg.gear_geometry(pair)
     # slot 0 over one mesh period, then slot 1 over the next: one pair's engagement
     seq = lambda a: np.concatenate([np.asarray(a)[:, 0], np.asarray(a)[:, 1]])  # noqa: E731
