@@ -122,18 +122,15 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
                 basis = basis.at[k + 1].set(jnp.where(happy, 0.0, w / jnp.where(happy, 1.0, hn)))
                 h = h.at[k + 1].set(hn)
 
-                # the earlier rotations, then a new one that zeroes h[k+1]
+                # the k earlier rotations (a loop of k, not of the cycle's m: most cycles end
+                # after a few vectors), then a new one that zeroes h[k+1]
                 def rotate(i, h):
                     hi, hj = h[i], h[i + 1]
-                    act = i < k
                     return (
-                        h.at[i]
-                        .set(jnp.where(act, cs[i] * hi + sn[i] * hj, hi))
-                        .at[i + 1]
-                        .set(jnp.where(act, -sn[i] * hi + cs[i] * hj, hj))
+                        h.at[i].set(cs[i] * hi + sn[i] * hj).at[i + 1].set(-sn[i] * hi + cs[i] * hj)
                     )
 
-                h = jax.lax.fori_loop(0, m, rotate, h)
+                h = jax.lax.fori_loop(0, k, rotate, h)
                 c_k, s_k = _givens(h[k], h[k + 1])
                 h = h.at[k].set(c_k * h[k] + s_k * h[k + 1]).at[k + 1].set(0.0)
                 g = g.at[k + 1].set(-s_k * g[k]).at[k].set(c_k * g[k])
