@@ -249,8 +249,8 @@ def _mib(nbytes):
 
 def _path_contacts(rpm, model, courant=1.0, torque=700.0):
     """The contact states of one tooth pair's whole engagement on the paper's calibrated pair
-    (``torque``, 700 N m by default, 90 °C), quasi-static load sharing, at the time steps Δt = C Δx/ur of the pitch-point
-    contact (C = ``courant``): (contacts, times, Δt)."""
+    (``torque``, 700 N m by default, 90 °C), quasi-static load sharing, at the time steps
+    Δt = C Δx/ur of the pitch-point contact (C = ``courant``): (contacts, times, Δt)."""
     import numpy as np
 
     from jaxgear.material import reduced_modulus
