@@ -57,6 +57,16 @@ class RowCache:
         return self.saved[key]
 
 
+def row_cache_from_command_line(doc: str, argv=None) -> RowCache:
+    """The RowCache of a benchmark whose only option is ``--rows`` (described by its docstring's
+    first line)."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("--rows", type=Path, help=ROWS_HELP)
+    return RowCache(ap.parse_args(argv).rows)
+
+
 def compile_then_run(fn, *args):
     """(result, compile s, run s): ``jax.jit(fn)`` lowered and compiled for ``args``, then called
     once on them (compile and run timed apart: a long march is run once)."""

@@ -29,7 +29,6 @@ runs).
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -43,7 +42,12 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
-from _report import ROWS_HELP, RowCache, compile_then_run, machine, write_section  # noqa: E402
+from _report import (  # noqa: E402
+    compile_then_run,
+    machine,
+    row_cache_from_command_line,
+    write_section,
+)
 from ehl_cases import gear_contact  # noqa: E402
 from mixed_thermal import _path_contacts  # noqa: E402
 
@@ -130,18 +134,16 @@ def _exponent(low, high, part):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--rows", type=Path, help=ROWS_HELP)
-    args = ap.parse_args(argv)
-    cache = RowCache(args.rows)
+    cache = row_cache_from_command_line(__doc__, argv)
+
+    def at_both_torques(key, measure):
+        """(row at 700 N m, row at 1500 N m), measured by ``measure(torque)`` or cached."""
+        return tuple(cache.get(f"{key} {t:g}", lambda t=t: measure(t)) for t in TORQUES)
+
     held_rows = []
     for kind, n, seed in HELD:
-        low, high = (
-            cache.get(
-                f"held {kind} {n} {seed} {t:g}",
-                lambda kind=kind, n=n, seed=seed, t=t: held(kind, n, seed, t),
-            )
-            for t in TORQUES
+        low, high = at_both_torques(
+            f"held {kind} {n} {seed}", lambda t, kind=kind, n=n, seed=seed: held(kind, n, seed, t)
         )
         ks = " | ".join(f"{_exponent(low, high, p):.2f}" for p in PARTS)
         held_rows.append(
@@ -151,11 +153,8 @@ def main(argv=None):
         )
     path_rows = []
     for kind, rpm in PATH:
-        low, high = (
-            cache.get(
-                f"path {kind} {rpm:g} {t:g}", lambda kind=kind, rpm=rpm, t=t: path(kind, rpm, t)
-            )
-            for t in TORQUES
+        low, high = at_both_torques(
+            f"path {kind} {rpm:g}", lambda t, kind=kind, rpm=rpm: path(kind, rpm, t)
         )
         ratios = " | ".join(f"{high[p] / low[p]:.2f}" for p in PARTS)
         path_rows.append(

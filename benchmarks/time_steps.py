@@ -19,7 +19,6 @@ Run: ``python benchmarks/time_steps.py [--rows FILE]`` (``--rows`` keeps measure
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -33,7 +32,12 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
-from _report import ROWS_HELP, RowCache, compile_then_run, machine, write_section  # noqa: E402
+from _report import (  # noqa: E402
+    compile_then_run,
+    machine,
+    row_cache_from_command_line,
+    write_section,
+)
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
@@ -110,10 +114,7 @@ def measure(film, n, scheme, courant, tolerance=1e-9):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--rows", type=Path, help=ROWS_HELP)
-    args = ap.parse_args(argv)
-    cache = RowCache(args.rows)
+    cache = row_cache_from_command_line(__doc__, argv)
     rows = []
     for film, n, scheme, courants in RUNS:
         for courant in courants:
