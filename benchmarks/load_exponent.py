@@ -15,7 +15,7 @@ their share of the load need not fall. This measures k both ways:
   (80 cells of 257 nodes; Δt = Δx/ur, backward Euler), the means taken over the last three
   quarters of the steps that converged; statistical and deterministic on 257, 513 and 1025 nodes
   (the same profiles, resolved more finely), and the deterministic film for four roughness seeds
-  on 257 and 513 nodes and three on 1025;
+  on 257, 513 and 1025 nodes;
 - along the path: one whole engagement (quasi-static load sharing of the calibrated pair, 257
   nodes, thermal, as RESULTS ``mixed_engagement``) at 700 and 1500 N m: the friction energy of
   one engagement, whose ratio is the ratio of Φ̄ at one speed (Φ̄ = mesh frequency × energy per
@@ -64,8 +64,7 @@ PARTS = ("total", "sliding", "rolling", "asperity")
 HELD = (
     *[("statistical", n, 0) for n in (257, 513, 1025)],
     *[("deterministic", n, 0) for n in (257, 513, 1025)],
-    *[("deterministic", n, seed) for n in (257, 513) for seed in (1, 2, 3)],
-    *[("deterministic", 1025, seed) for seed in (1, 2)],
+    *[("deterministic", n, seed) for n in (257, 513, 1025) for seed in (1, 2, 3)],
 )
 # along the path: (mixed model, rpm), thermal, 257 nodes
 PATH = (
