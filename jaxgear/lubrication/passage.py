@@ -6,7 +6,9 @@ passage marches the EHL problem through a given sequence of contact states with 
 
 - Reynolds with the squeeze term ∂(ρh)/∂t by backward Euler or BDF2 (``EHLModel.time_scheme``),
   ρh of the previous steps interpolated onto this step's nodes (the grid follows the Hertz
-  half-width);
+  half-width), or, along the characteristics (``EHLModel.transport = "characteristic"``), the
+  wedge and squeeze terms together as D(ρh)/Dt, the previous films read where the mean velocity
+  carried them from (their roughness evaluated from the profiles there);
 - roughness Sj(x, t) = scale · zj(x − xj0 − dj(t)), dj = ∫ uj dt by the trapezoidal rule;
 - thermal (``model.thermal``): the surface temperatures by the transient moving-heat-source model
   with memory (paper Eq. 9; :class:`~jaxgear.lubrication.thermal.SubsurfaceTemperature`, carried
@@ -16,8 +18,9 @@ passage marches the EHL problem through a given sequence of contact states with 
 The time step is the caller's choice. Tied to the grid, Δt = Δx/ur moves the roughness about one
 cell per step (EHL_NOTES "Transient"); :func:`grid_time_step` gives it. Backward Euler is first
 order in Δt: halving Δt halves the time-discretisation error; BDF2 is second order (both tested).
-A roughness whose shortest wavelength spans a few cells passes a node in a few such steps, so a
-rough film's friction needs Δt below Δx/ur (RESULTS ``mixed_time_steps``).
+A roughness whose shortest wavelength spans a few cells passes a node in a few such steps, so with
+the Eulerian terms a rough film's friction needs Δt below Δx/ur; along the characteristics it
+does not, up to a few Δx/ur (RESULTS ``mixed_time_steps``).
 """
 
 from __future__ import annotations
@@ -35,10 +38,13 @@ from .ehl import (
     EHLModel,
     EHLSolution,
     LineContact,
+    _film_at_feet,
     _grid_positions,
     _Inputs,
+    _roughness_offset,
     _solve_impl,
     _warm_args,
+    transport_shift,
 )
 from .lubricant import Lubricant
 from .roughness import Surfaces
@@ -93,27 +99,22 @@ def _temperature_start(mixed, prev, x, inlet, shift):
     return jnp.interp(x - shift, prev.x, rise, left=0.0, right=0.0)
 
 
-def _roughness_offset(mixed, surfaces, x, d):
-    if mixed != "deterministic":
-        return jnp.zeros_like(x)
-    return -(surfaces.displaced_height(0, x, d[0]) + surfaces.displaced_height(1, x, d[1]))
-
-
-def _squeeze_history(model, x, rho_h_prev, inv_dt, older, usable, dt):
+def _squeeze_history(model, rho_h_prev, inv_dt, older, usable, dt, read_older):
     """The squeeze term's (1/Δt, ρh_prev) for ``model.time_scheme``.
 
     Backward Euler: ∂(ρh)/∂t ≈ (ρh − ρhⁿ)/Δt. BDF2 with variable steps (ω = Δt/Δt_prev):
     ∂(ρh)/∂t ≈ [a0 ρh − (1 + ω) ρhⁿ + ω²/(1 + ω) ρhⁿ⁻¹]/Δt, a0 = (1 + 2ω)/(1 + ω); the term is
     linear in ρh, so it is one backward-Euler-shaped term with 1/Δt × a0 and the reference
-    [(1 + ω) ρhⁿ − ω²/(1 + ω) ρhⁿ⁻¹]/a0 (the residual is unchanged). ``older`` = (x, ρh, Δt_prev)
-    of step n − 1; where it is not ``usable`` (the first transient step, or after a failed step)
-    the step is backward Euler."""
+    [(1 + ω) ρhⁿ − ω²/(1 + ω) ρhⁿ⁻¹]/a0 (the residual is unchanged). ``older`` carries step
+    n − 1 (its ``[-1]`` Δt_prev), ``read_older(older)`` its ρh where this step reads it; where
+    it is not ``usable`` (the first transient step, or after a failed step) the step is backward
+    Euler."""
     if model.time_scheme != "bdf2":
         return inv_dt, rho_h_prev
-    x_old, rho_h_old, dt_prev = older
+    dt_prev = older[-1]
     w = dt / jnp.maximum(dt_prev, 1e-300)
     a0 = jnp.where(usable, (1.0 + 2.0 * w) / (1.0 + w), 1.0)
-    rho_h_old = jnp.interp(x, x_old, rho_h_old)
+    rho_h_old = read_older(older)
     blended = ((1.0 + w) * rho_h_prev - w * w / (1.0 + w) * rho_h_old) / a0
     return inv_dt * a0, jnp.where(usable, blended, rho_h_prev)
 
@@ -123,6 +124,8 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
     dt = jnp.maximum(t - t_prev, 1e-300)
     u_now = jnp.stack([contact.u1, contact.u2])
     d_prev = d
+    # the film's transport in this step along the characteristics (0 for the Eulerian term)
+    shift = transport_shift(model, 0.25 * jnp.sum(u_prev + u_now) * (t - t_prev))
     if not first:
         # the first state is at ``times[0]``, where the surfaces stand at the given displacement
         # (the carry's t_prev = times[0] − Δt0 only gives the first step a Δt to read)
@@ -141,10 +144,23 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         # does not fail every later step.
         prev_ok = prev.converged & jnp.all(jnp.isfinite(prev.rho_h))
         prev_ok = prev_ok & jnp.all(jnp.isfinite(prev.temperature))
-        rho_h_prev = jnp.where(prev_ok, jnp.interp(x, prev.x, prev.rho_h), 0.0)
+        # along the characteristics (``EHLModel.transport``) the previous films are read where
+        # the mean velocity carried them from: x − ∫ ur dt
+        rho_h_prev = _film_at_feet(
+            model, mixed, surfaces, x, shift, prev.x, prev.rho_h, prev.density, d_prev
+        )
+        rho_h_prev = jnp.where(prev_ok, rho_h_prev, 0.0)
         inv_dt = jnp.where(prev_ok, 1.0 / dt, 0.0)
+
+        def read_older(older):
+            # step n − 1, carried along the characteristics over that step and this one
+            x_old, rho_h_old, rho_old, d_old, shift_old, _ = older
+            return _film_at_feet(
+                model, mixed, surfaces, x, shift + shift_old, x_old, rho_h_old, rho_old, d_old
+            )
+
         inv_dt, rho_h_prev = _squeeze_history(
-            model, x, rho_h_prev, inv_dt, older, prev_ok & older_ok, dt
+            model, rho_h_prev, inv_dt, older, prev_ok & older_ok, dt, read_older
         )
         rise = jnp.interp(x, prev.x, prev.temperature - inlet, left=0.0, right=0.0)
         rise = jnp.where(prev_ok, rise, 0.0)
@@ -194,7 +210,7 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         ).temperature
     # step n − 1 as BDF2's older level for the next step: usable if it was a solution (not the
     # first step's placeholder) that converged
-    older = (prev.x, prev.rho_h, dt)
+    older = (prev.x, prev.rho_h, prev.density, d_prev, shift, dt)
     older_ok = jnp.asarray(False) if first else prev_ok
     return (sol, temp1, temp2, d, t, u_now, older, older_ok), sol
 
@@ -224,7 +240,14 @@ def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, 
     )
     placeholder = jax.tree_util.tree_map(lambda s: jnp.zeros(s.shape, s.dtype), proto)
     placeholder = eqx.tree_at(lambda s: s.x, placeholder, x0)
-    older = (x0, jnp.zeros_like(x0), dt0)
+    older = (
+        x0,
+        jnp.zeros_like(x0),
+        jnp.zeros_like(x0),
+        jnp.asarray(displacement0),
+        jnp.zeros_like(dt0),
+        dt0,
+    )
     carry = (
         placeholder,
         zeros_t,

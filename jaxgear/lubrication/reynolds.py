@@ -7,7 +7,9 @@ d/dx(ρh³/(12η) dp/dx) = um d(ρh)/dx + ∂(ρh)/∂t becomes
 
     R(X) = d/dX(ε dP/dX) − d(ρ̄H)/dX − σ (ρ̄H − ρ̄H_prev) = 0,  ε = ρ̄H³/(η̄ λ̄),
     λ̄ = 12 η0 um R²/(b³ ph),  σ = b/(um Δt)  (backward Euler; σ = 0 when steady; BDF2 is the same term with a scaled σ
-    and a blended ρ̄H_prev, ``passage._squeeze_history``).
+    and a blended ρ̄H_prev, ``passage._squeeze_history``). Along the characteristics
+    (``EHLModel.transport``) the wedge term is dropped and ρ̄H_prev is read at the feet X − T of
+    the characteristics: the squeeze term is then the material derivative D(ρ̄H)/DT.
 
 Finite volumes on a uniform grid: the Poiseuille term with ε at cell faces (arithmetic mean), the
 wedge
@@ -43,6 +45,17 @@ def smooth_positive(h, floor):
     return jnp.where(positive, 0.5 * (h_pos + r), 0.5 * floor * floor / (r - h_neg))
 
 
+def wedge_term(rho_h, spacing, wedge_order: int = 2):
+    """d(ρ̄H)/dX by first- or second-order upwind differences (flow towards +X), shape (N,)."""
+    back1 = jnp.concatenate([rho_h[:1], rho_h[:-1]])  # ρ̄H_{i−1}
+    first = (rho_h - back1) / spacing
+    if wedge_order == 1:
+        return first
+    back2 = jnp.concatenate([rho_h[:2], rho_h[:-2]])
+    second = (3.0 * rho_h - 4.0 * back1 + back2) / (2.0 * spacing)
+    return jnp.where(jnp.arange(rho_h.shape[0]) < 2, first, second)
+
+
 def reynolds_residual(
     pressure,
     rho_h,
@@ -51,6 +64,7 @@ def reynolds_residual(
     squeeze,
     rho_h_previous,
     wedge_order: int = 2,
+    wedge_weight=1.0,
 ):
     """R_i of the discrete Reynolds equation at every node (boundary entries are meaningless).
 
@@ -62,6 +76,9 @@ def reynolds_residual(
         squeeze: σ = b/(um Δt), 0 for a steady solve.
         rho_h_previous: ρ̄H of the previous time step (ignored when σ = 0).
         wedge_order: 1 or 2 (upwind order of d(ρ̄H)/dX).
+        wedge_weight: 1, or 0 where the squeeze term is the material derivative D(ρ̄H)/DT along
+            the characteristics X − T (``rho_h_previous`` read at their feet), which carries
+            the wedge term itself (``EHLModel.transport = "characteristic"``).
 
     Returns:
         (R, D): the residual and the magnitude of its Poiseuille diagonal (ε_{i−½} + ε_{i+½})/Δ²,
@@ -74,13 +91,6 @@ def reynolds_residual(
     eps_face = 0.5 * (eps[1:] + eps[:-1])  # faces i+1/2, i = 0..N-2
     flux = eps_face * (pressure[1:] - pressure[:-1]) / spacing  # ε dP/dX at faces
     poiseuille = jnp.zeros_like(pressure).at[1:-1].set((flux[1:] - flux[:-1]) / spacing)
-    back1 = jnp.concatenate([rho_h[:1], rho_h[:-1]])  # ρ̄H_{i−1}
-    if wedge_order == 1:
-        wedge = (rho_h - back1) / spacing
-    else:
-        back2 = jnp.concatenate([rho_h[:2], rho_h[:-2]])
-        second = (3.0 * rho_h - 4.0 * back1 + back2) / (2.0 * spacing)
-        first = (rho_h - back1) / spacing
-        wedge = jnp.where(jnp.arange(rho_h.shape[0]) < 2, first, second)
+    wedge = wedge_weight * wedge_term(rho_h, spacing, wedge_order)
     diag = jnp.zeros_like(pressure).at[1:-1].set((eps_face[1:] + eps_face[:-1]) / spacing**2)
     return poiseuille - wedge - squeeze * (rho_h - rho_h_previous), diag
