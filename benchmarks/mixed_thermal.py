@@ -28,11 +28,11 @@ implies, where the whole engagement is out of reach (2049 nodes: Δx 0.78 µm, t
 ``--rows`` keeps the rows of all these passages in one table across runs. Writes the
 ``mixed_held_steps`` section.
 
-``--engagement-fine [--rpm R ...] [--sweeps S] [--time-scheme S] [--courant C] [--tolerance T]
-[--rows FILE]``:
+``--engagement-fine [--rpm R ...] [--sweeps S] [--time-scheme S] [--transport T] [--courant C]
+[--tolerance T] [--rows FILE]``:
 one whole engagement of the polished film (λs 2.5 µm) along the path on each grid of ``--nodes``
-with ``EHLModel(linear_solver="krylov")``, by backward Euler or BDF2 at Δt = C Δx/ur, marched, not
-extrapolated. Writes the ``mixed_engagement_fine`` section.
+with ``EHLModel(linear_solver="krylov")``, by backward Euler or BDF2 (Eulerian or along the
+characteristics) at Δt = C Δx/ur, marched, not extrapolated. Writes the ``mixed_engagement_fine`` section.
 
 ``--passage-iterations``: where the deterministic passage spends its time: the Newton iterations
 of each step (all attempts) with the warm-start budget of the default model (12) and with 60, at
@@ -133,6 +133,11 @@ def main(argv=None):
         help="with --engagement-fine: EHLModel.time_scheme (backward_euler, bdf2)",
     )
     ap.add_argument(
+        "--transport",
+        default="eulerian",
+        help="with --engagement-fine: EHLModel.transport (eulerian, characteristic)",
+    )
+    ap.add_argument(
         "--courant",
         type=float,
         default=1.0,
@@ -159,6 +164,7 @@ def main(argv=None):
             args.time_scheme,
             args.courant,
             args.tolerance,
+            args.transport,
         )
     if args.held_steps:
         return held_steps(
@@ -429,7 +435,14 @@ def engagement_grid(sizes):
 
 
 def engagement_fine(
-    sizes, rpms, cache, sweeps=None, scheme="backward_euler", courant=1.0, tolerance=1e-9
+    sizes,
+    rpms,
+    cache,
+    sweeps=None,
+    scheme="backward_euler",
+    courant=1.0,
+    tolerance=1e-9,
+    transport="eulerian",
 ):
     """One whole engagement of the polished film (λs 2.5 µm, iso-thermal, 700 N m) marched along
     the path on the grids the roughness needs, with the Krylov Newton directions (and ``sweeps``
@@ -451,12 +464,14 @@ def engagement_fine(
             linear_solver="krylov",
             time_scheme=scheme,
             tolerance=tolerance,
+            transport=transport,
             **kw,
         )
         k, t_compile, t_run, sols, ok, its, loss, x_mid = _march_path(model, rpm, surf, courant)
         row = (
             f"| {n} | {(x_mid[1] - x_mid[0]) * 1e6:.2f} | {rpm:.0f} | "
-            f"{'default' if sweeps is None else sweeps} | {scheme.replace('_', ' ')} | "
+            f"{'default' if sweeps is None else sweeps} | {scheme.replace('_', ' ')}"
+            f"{'' if transport == 'eulerian' else ', ' + transport} | "
             f"{courant:g} | {tolerance:g} | {k} | {t_compile:.0f} | {t_run:.0f} | "
             f"{t_run / k * 1e3:.0f} | {int(ok.sum())} of {k} | {its[1:].mean():.1f} | "
             f"{float(np.max(np.asarray(sols.p))) / 1e9:.2f} | {loss:.0f} |"
@@ -470,6 +485,7 @@ def engagement_fine(
             key = f"{n} {rpm:.0f} {sweeps}"
             key += "" if (scheme, courant) == ("backward_euler", 1.0) else f" {scheme} {courant:g}"
             key += "" if tolerance == 1e-9 else f" tol {tolerance:g}"
+            key += "" if transport == "eulerian" else f" {transport}"
             cache.get(key, lambda n=n, rpm=rpm: measure(n, rpm))
     rows = list(cache.saved.values())
     body = "\n".join(

@@ -9,7 +9,8 @@ polished surfaces filtered at λs = 2.5 µm (a full film: `figures.field_surface
 steady start over the same rolling distance (40 cells of the 2049-node grid, 31 µm) with
 Δt = C Δx/ur, C the Courant number, by backward Euler and by BDF2 (`EHLModel.time_scheme`), on
 1025, 2049 and 4097 nodes; and the ground surfaces (unfiltered) on the 257 nodes of the
-deterministic engagement (`mixed_engagement`); and, for the polished film by BDF2 at C = 0.5 on
+deterministic engagement (`mixed_engagement`); each with the Eulerian wedge and squeeze terms and
+along the characteristics (`EHLModel.transport`); and, for the polished film by BDF2 at C = 0.5 on
 2049 nodes, the Newton tolerance (`EHLModel.tolerance`) from 1e-7 to 1e-3. Reported: the loss per width at the window's end (the roughness then
 stands at the same place in every run), the mean over the window's second half, p_max and h_min
 at the end, and the cost. Writes the ``mixed_time_steps`` section of benchmarks/RESULTS.md.
@@ -49,23 +50,30 @@ WINDOW_CELLS_2049 = 40  # the rolling distance, in cells of the 2049-node grid
 
 GROUND_WINDOW_CELLS_2049 = 320  # the ground film's: 40 cells of its 257-node grid (250 µm)
 
-# (film, nodes, scheme, Courant numbers)
+# (film, nodes, scheme, Courant numbers, transport)
 RUNS = (
-    ("polished", 2049, "backward_euler", (4.0, 2.0, 1.0, 0.5, 0.25)),
-    ("polished", 2049, "bdf2", (4.0, 2.0, 1.0, 0.5, 0.25)),
-    ("polished", 1025, "backward_euler", (1.0,)),
-    ("polished", 1025, "bdf2", (1.0, 0.5, 0.25)),
-    ("polished", 4097, "backward_euler", (1.0,)),
-    ("polished", 4097, "bdf2", (1.0, 0.5)),
-    ("ground", 257, "backward_euler", (1.0, 0.5, 0.25)),
-    ("ground", 257, "bdf2", (1.0, 0.5, 0.25)),
+    ("polished", 2049, "backward_euler", (4.0, 2.0, 1.0, 0.5, 0.25), "eulerian"),
+    ("polished", 2049, "bdf2", (4.0, 2.0, 1.0, 0.5, 0.25), "eulerian"),
+    ("polished", 1025, "backward_euler", (1.0,), "eulerian"),
+    ("polished", 1025, "bdf2", (1.0, 0.5, 0.25), "eulerian"),
+    ("polished", 4097, "backward_euler", (1.0,), "eulerian"),
+    ("polished", 4097, "bdf2", (1.0, 0.5), "eulerian"),
+    ("ground", 257, "backward_euler", (1.0, 0.5, 0.25), "eulerian"),
+    ("ground", 257, "bdf2", (1.0, 0.5, 0.25), "eulerian"),
+    # along the characteristics (``EHLModel.transport``)
+    ("polished", 2049, "bdf2", (4.0, 2.0, 1.0, 0.5), "characteristic"),
+    ("polished", 2049, "backward_euler", (1.0,), "characteristic"),
+    ("polished", 1025, "bdf2", (2.0, 1.0), "characteristic"),
+    ("polished", 4097, "bdf2", (2.0, 1.0), "characteristic"),
+    ("ground", 257, "bdf2", (2.0, 1.0, 0.5), "characteristic"),
+    ("ground", 257, "backward_euler", (1.0,), "characteristic"),
 )
 # the Newton tolerance (‖F‖∞, pressures in ph) of the polished film by BDF2 at C = 0.5 on 2049
 # nodes, against the default 1e-9: how much of a step's cost buys digits the time step has not
 TOLERANCES = (1e-7, 1e-6, 1e-5, 1e-4, 1e-3)
 
 
-def measure(film, n, scheme, courant, tolerance=1e-9):
+def measure(film, n, scheme, courant, tolerance=1e-9, transport="eulerian"):
     # the polished full film: Krylov directions, unrelaxed warm starts (as --engagement-fine);
     # the ground film on 257 nodes: the default deterministic model (dense LU, relaxed starts)
     if film == "polished":
@@ -75,7 +83,12 @@ def measure(film, n, scheme, courant, tolerance=1e-9):
         options = {}
         window = GROUND_WINDOW_CELLS_2049
     model = jg.EHLModel(
-        n_nodes=n, mixed="deterministic", time_scheme=scheme, tolerance=tolerance, **options
+        n_nodes=n,
+        mixed="deterministic",
+        time_scheme=scheme,
+        tolerance=tolerance,
+        transport=transport,
+        **options,
     )
     c = gear_contact(rpm=3500.0)
     dt = courant * float(grid_time_step(c, LUB, model))
@@ -97,6 +110,7 @@ def measure(film, n, scheme, courant, tolerance=1e-9):
         "nodes": n,
         "dx_um": dx * 1e6,
         "scheme": scheme,
+        "transport": transport,
         "courant": courant,
         "tolerance": tolerance,
         "steps": steps,
@@ -116,19 +130,25 @@ def measure(film, n, scheme, courant, tolerance=1e-9):
 def main(argv=None):
     cache = row_cache_from_command_line(__doc__, argv)
     rows = []
-    for film, n, scheme, courants in RUNS:
+    for film, n, scheme, courants, transport in RUNS:
         for courant in courants:
-            # the polished rows keep the keys they were first measured under
+            # the Eulerian polished rows keep the keys they were first measured under
             key = f"{n} {scheme} {courant}" + ("" if film == "polished" else f" {film}")
+            key += "" if transport == "eulerian" else f" {transport}"
             rows.append(
-                cache.get(key, lambda f=film, n=n, s=scheme, c=courant: measure(f, n, s, c))
+                cache.get(
+                    key,
+                    lambda f=film, n=n, s=scheme, c=courant, t=transport: measure(
+                        f, n, s, c, transport=t
+                    ),
+                )
             )
     for tol in TOLERANCES:
         key = f"2049 bdf2 0.5 tol {tol:g}"
         rows.append(cache.get(key, lambda t=tol: measure("polished", 2049, "bdf2", 0.5, t)))
     table = [
         f"| {r.get('film', 'polished')} | {r['nodes']} | {r['dx_um']:.2f} | "
-        f"{r['scheme'].replace('_', ' ')} | {r['courant']:g} | {r.get('tolerance', 1e-9):g} | "
+        f"{r['scheme'].replace('_', ' ')} | {r.get('transport', 'eulerian')} | {r['courant']:g} | {r.get('tolerance', 1e-9):g} | "
         f"{r['steps']} | {r['compile_s']:.0f} | {r['run_s']:.1f} | {r['its']:.1f} | "
         f"{r['converged']} of {r['steps']} | {r['p_max']:.3f} | {r['h_min']:.4f} | "
         f"{r['loss_end']:.2f} | {r['loss_half']:.2f} |"
@@ -148,10 +168,10 @@ def main(argv=None):
             "the end; its: Newton iterations a step (steps 1…); tolerance: `EHLModel.tolerance`, "
             "the Newton solves' ‖F‖∞ (default 1e-9).",
             "",
-            "| film | nodes | Δx, µm | scheme | C | tolerance | steps | compile, s | run, s | "
+            "| film | nodes | Δx, µm | scheme | transport | C | tolerance | steps | compile, s | run, s | "
             "its a step | converged | p_max, GPa | h_min, µm | loss at the end, kW/m | "
             "loss, 2nd half, kW/m |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
             *table,
         ]
     )
