@@ -34,6 +34,13 @@ one whole engagement of the polished film (λs 2.5 µm) along the path on each g
 with ``EHLModel(linear_solver="krylov")``, by backward Euler or BDF2 (Eulerian or along the
 characteristics) at Δt = C Δx/ur, marched, not extrapolated. Writes the ``mixed_engagement_fine`` section.
 
+``--engagement-transport [--rows FILE]``: one engagement along the path (257 nodes, ground,
+Δt = Δx/ur) of the deterministic film, iso-thermal and thermal, with the Eulerian transport
+(backward Euler, as ``--engagement``) and along the characteristics (BDF2,
+``EHLModel.transport``), beside the statistical film's, at 500 and 3500 rpm: cost, converged
+steps, and the loss split into sliding, asperity and rolling parts. Writes the
+``mixed_engagement_transport`` section.
+
 ``--passage-iterations``: where the deterministic passage spends its time: the Newton iterations
 of each step (all attempts) with the warm-start budget of the default model (12) and with 60, at
 500 and 3500 rpm on 257 nodes; writes the ``mixed_passage_iterations`` section.
@@ -109,6 +116,12 @@ def main(argv=None):
         "(a full film) instead of the ground ones",
     )
     ap.add_argument(
+        "--engagement-transport",
+        action="store_true",
+        help="the ground engagement along the path, Eulerian and along the characteristics "
+        "(--rows)",
+    )
+    ap.add_argument(
         "--engagement-fine",
         action="store_true",
         help="one polished engagement on each grid of --nodes with the Krylov directions "
@@ -149,12 +162,14 @@ def main(argv=None):
         default=1e-9,
         help="with --engagement-fine: EHLModel.tolerance, the Newton solves' ‖F‖∞",
     )
-    ap.add_argument("--rows", type=Path, help=ROWS_HELP + " (--held-steps)")
+    ap.add_argument("--rows", type=Path, help=ROWS_HELP + " (--held-steps, --engagement-transport)")
     args = ap.parse_args(argv)
     if args.engagement:
         return engagement()
     if args.engagement_grid:
         return engagement_grid(args.nodes)
+    if args.engagement_transport:
+        return engagement_transport(RowCache(args.rows))
     if args.engagement_fine:
         return engagement_fine(
             args.nodes,
@@ -432,6 +447,77 @@ def engagement_grid(sizes):
         ]
     )
     write_section("mixed_engagement_grid", body)
+
+
+def engagement_transport(cache):
+    """The ground engagement along the path (257 nodes, Δt = Δx/ur, 700 N m) of the deterministic
+    film with the Eulerian transport and along the characteristics, iso-thermal and thermal, and
+    the statistical film (thermal) beside them: cost and the loss split. Rows kept in ``cache``."""
+    import numpy as np
+
+    surf = jg.presets.ground()
+    cases = (
+        ("statistical, thermal", dict(mixed="statistical", thermal=True)),
+        ("deterministic, iso-thermal, Eulerian (backward Euler)", dict(mixed="deterministic")),
+        (
+            "deterministic, iso-thermal, characteristic (BDF2)",
+            dict(mixed="deterministic", transport="characteristic", time_scheme="bdf2"),
+        ),
+        (
+            "deterministic, thermal, Eulerian (backward Euler)",
+            dict(mixed="deterministic", thermal=True),
+        ),
+        (
+            "deterministic, thermal, characteristic (BDF2)",
+            dict(
+                mixed="deterministic", thermal=True, transport="characteristic", time_scheme="bdf2"
+            ),
+        ),
+    )
+
+    def measure(label, kw, rpm):
+        model = jg.EHLModel(n_nodes=257, **kw)
+        k, t_compile, t_run, sols, ok, its, loss, _ = _march_path(model, rpm, surf)
+
+        def mean(field):  # W per contact over the 20 mm face width, over the converged steps
+            return float(np.sum(np.where(ok, getattr(sols, field), 0.0)) / max(ok.sum(), 1)) * 0.02
+
+        asperity = mean("power_loss_asperity")
+        fluid = mean("power_loss_sliding") - asperity
+        row = (
+            f"| {label} | {rpm:.0f} | {k} | {t_compile:.0f} | {t_run:.1f} | "
+            f"{int(ok.sum())} of {k} | {its[1:].mean():.1f} | {loss:.0f} | {fluid:.0f} | "
+            f"{asperity:.0f} | {mean('power_loss_rolling'):.0f} |"
+        )
+        print(row, flush=True)
+        return row
+
+    rows = []
+    for rpm in (3500.0, 500.0):
+        for label, kw in cases:
+            key = f"{label} {rpm:.0f}"
+            rows.append(cache.get(key, lambda label=label, kw=kw, rpm=rpm: measure(label, kw, rpm)))
+    body = "\n".join(
+        [
+            "## The ground engagement along the characteristics (`--engagement-transport`, issue 4)",
+            "",
+            f"Machine: {machine()}. One engagement along the path of contact (as "
+            "`mixed_engagement`: ground, 700 N m, 257 nodes, Δt = Δx/ur of the pitch-point "
+            "contact), the deterministic film with the Eulerian transport (the default, backward "
+            'Euler) and along the characteristics (`EHLModel(transport="characteristic", '
+            'time_scheme="bdf2")`), and the statistical film (the contact model of '
+            "`Fidelity.paper()`). "
+            "Its: Newton iterations a step (all attempts, steps 2…). Losses: means over the "
+            "converged steps, per contact over the 20 mm face width: the total and its fluid "
+            "sliding, asperity (boundary friction) and rolling (Poiseuille) parts.",
+            "",
+            "| film | rpm | steps | compile, s | run, s | converged | its a step | loss, W | "
+            "fluid sliding, W | asperity, W | rolling, W |",
+            "|---|---|---|---|---|---|---|---|---|---|---|",
+            *rows,
+        ]
+    )
+    write_section("mixed_engagement_transport", body)
 
 
 def engagement_fine(
