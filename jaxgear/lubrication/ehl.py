@@ -262,7 +262,13 @@ class EHLModel(eqx.Module):
             agrees within 1.9 % on 2049 nodes (the Eulerian schemes: 2.5× between C = 4 and
             their Δt → 0 limit) and 1025 nodes give within 4 % of it (Eulerian: 1.8×); on the
             ground film (257 nodes) the loss is ~4× below the Eulerian schemes', whose excess is
-            Poiseuille heat. Steady solves have no squeeze term and ignore it.
+            Poiseuille heat. Steady solves have no squeeze term and ignore it. Use it with BDF2
+            and steps of a few cells: for a steady film it is the upwind difference over the C
+            cells a step spans (backward Euler: first order), so a step must stay short against
+            the outlet constriction. Measured on a held smooth film (2000 rpm, BDF2, 11 steps):
+            the minimum film moves by ≤ 2 % up to C Δx = 0.05 b (513 nodes, C ≤ 4), by 6 % at
+            0.09 b (513, C = 8), and by 85 % at 0.19 b (129, C = 4); the coupled model's
+            transient rung, a third of a Hertz width a step, is no place for it.
     """
 
     n_nodes: int = eqx.field(static=True, default=257)
