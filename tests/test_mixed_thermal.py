@@ -135,7 +135,10 @@ def test_relaxation_sweeps_default_to_100_iso_thermal_and_50_thermal_and_are_val
             jg.EHLModel(relaxation_sweeps=bad)
 
 
-def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_steady_film():
+@pytest.mark.parametrize("transport", ["eulerian", "characteristic"])
+def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_steady_film(
+    transport,
+):
     # A transient step that falls back to the cold solve continues from the smooth steady film in
     # r, which scales the roughness and blends the squeeze term's previous film from the smooth
     # film's ρ̄H (r = 0) to the previous step's rough one (r = 1). At r = 0 the smooth steady
@@ -143,16 +146,20 @@ def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_st
     # system must be the step's own. The roughness-only continuation it replaced kept the rough
     # previous film at r = 0: at the smooth solution its residual is O(1) (measured ‖F‖∞ = 17,
     # against 1e-14 for the blend), and 26 of 212 cold solves along the path at 3500 rpm failed
-    # their first roughness step.
+    # their first roughness step. Along the characteristics (``EHLModel.transport``) the step has no
+    # wedge term, so the r = 0 reference carries the smooth film's wedge in the squeeze term.
+    import dataclasses
+
     from jaxgear.lubrication import ehl
 
+    model = dataclasses.replace(DET, transport=transport)
     c = gear_contact(rpm=3500.0)
-    dt = float(grid_time_step(c, LUB, DET))
+    dt = float(grid_time_step(c, LUB, model))
     surf = ground()
-    steady = jg.solve_ehl(c, LUB, DET, surf, displacement=jnp.zeros(2))
+    steady = jg.solve_ehl(c, LUB, model, surf, displacement=jnp.zeros(2))
     assert bool(steady.converged)
     # the next step's inputs, as solve_ehl builds them
-    x = ehl._grid_positions(DET, c, LUB)
+    x = ehl._grid_positions(model, c, LUB)
     d = np.asarray([float(c.u1), float(c.u2)]) * dt
     offset = -(surf.displaced_height(0, x, d[0]) + surf.displaced_height(1, x, d[1]))
     zero = jnp.zeros_like(x)
@@ -166,17 +173,17 @@ def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_st
         zero,
         surf.composite_rq,
     )
-    _, levels = ehl._levels(DET, inp)
+    _, levels = ehl._levels(model, inp)
     fine = levels[-1]
     smooth = [lev.smooth_steady() for lev in levels]
-    start, _ = ehl._cold_start(DET, smooth, ehl._schedules(DET, x.dtype)[0], cubic=True)
-    u_s, res, _, ok = ehl._newton(smooth[-1], start, 1.0, DET.max_iterations)
+    start, _ = ehl._cold_start(model, smooth, ehl._schedules(model, x.dtype)[0], cubic=True)
+    u_s, res, _, ok = ehl._newton(smooth[-1], start, 1.0, model.max_iterations)
     assert bool(ok), float(res)
     system = ehl._rough_homotopy(fine, smooth[-1].rho_h(u_s))
     at_zero, s = system(0.0)
     assert s == 1.0
     # r = 0: solved by the smooth steady film (to its Newton tolerance, 1e-9)
-    assert float(jnp.max(jnp.abs(at_zero.residual(u_s)))) < 10.0 * DET.tolerance
+    assert float(jnp.max(jnp.abs(at_zero.residual(u_s)))) < 10.0 * model.tolerance
     # the roughness-only continuation's r = 0 is not
     assert float(jnp.max(jnp.abs(fine.with_roughness(0.0).residual(u_s)))) > 0.1
     # r = 1: the step's own system (the blend reproduces the previous film to rounding)
