@@ -29,7 +29,7 @@ implies, where the whole engagement is out of reach (2049 nodes: Δx 0.78 µm, t
 ``mixed_held_steps`` section.
 
 ``--engagement-fine [--rpm R ...] [--sweeps S] [--time-scheme S] [--transport T] [--courant C]
-[--tolerance T] [--rows FILE]``:
+[--tolerance T] [--thermal] [--rows FILE]``:
 one whole engagement of the polished film (λs 2.5 µm) along the path on each grid of ``--nodes``
 with ``EHLModel(linear_solver="krylov")``, by backward Euler or BDF2 (Eulerian or along the
 characteristics) at Δt = C Δx/ur, marched, not extrapolated. Writes the ``mixed_engagement_fine`` section.
@@ -107,7 +107,8 @@ def main(argv=None):
     ap.add_argument(
         "--thermal",
         action="store_true",
-        help="with --held-steps: the thermal deterministic passage instead of the iso-thermal",
+        help="with --held-steps or --engagement-fine: the thermal deterministic passage instead of "
+        "the iso-thermal",
     )
     ap.add_argument(
         "--polished",
@@ -180,6 +181,7 @@ def main(argv=None):
             args.courant,
             args.tolerance,
             args.transport,
+            args.thermal,
         )
     if args.held_steps:
         return held_steps(
@@ -529,6 +531,7 @@ def engagement_fine(
     courant=1.0,
     tolerance=1e-9,
     transport="eulerian",
+    thermal=False,
 ):
     """One whole engagement of the polished film (λs 2.5 µm, iso-thermal, 700 N m) marched along
     the path on the grids the roughness needs, with the Krylov Newton directions (and ``sweeps``
@@ -551,13 +554,15 @@ def engagement_fine(
             time_scheme=scheme,
             tolerance=tolerance,
             transport=transport,
+            thermal=thermal,
             **kw,
         )
         k, t_compile, t_run, sols, ok, its, loss, x_mid = _march_path(model, rpm, surf, courant)
         row = (
             f"| {n} | {(x_mid[1] - x_mid[0]) * 1e6:.2f} | {rpm:.0f} | "
             f"{'default' if sweeps is None else sweeps} | {scheme.replace('_', ' ')}"
-            f"{'' if transport == 'eulerian' else ', ' + transport} | "
+            f"{'' if transport == 'eulerian' else ', ' + transport}"
+            f"{', thermal' if thermal else ''} | "
             f"{courant:g} | {tolerance:g} | {k} | {t_compile:.0f} | {t_run:.0f} | "
             f"{t_run / k * 1e3:.0f} | {int(ok.sum())} of {k} | {its[1:].mean():.1f} | "
             f"{float(np.max(np.asarray(sols.p))) / 1e9:.2f} | {loss:.0f} |"
@@ -572,6 +577,7 @@ def engagement_fine(
             key += "" if (scheme, courant) == ("backward_euler", 1.0) else f" {scheme} {courant:g}"
             key += "" if tolerance == 1e-9 else f" tol {tolerance:g}"
             key += "" if transport == "eulerian" else f" {transport}"
+            key += " thermal" if thermal else ""
             cache.get(key, lambda n=n, rpm=rpm: measure(n, rpm))
     rows = list(cache.saved.values())
     body = "\n".join(
@@ -581,7 +587,8 @@ def engagement_fine(
             "",
             f"Machine: {machine()}. One engagement along the path of contact (as "
             "`mixed_engagement`), polished surfaces filtered at λs = 2.5 µm (a full film), 700 N m, "
-            'iso-thermal, `EHLModel(mixed="deterministic", linear_solver="krylov")` with the '
+            "iso-thermal unless marked thermal, "
+            '`EHLModel(mixed="deterministic", linear_solver="krylov")` with the '
             "warm starts' relaxation sweeps, the time scheme and the Newton tolerance given; "
             "Δt = C Δx/ur of the pitch-point contact. Its: "
             "Newton iterations a step (all attempts, steps 2…). Loss: the mean over the converged "
