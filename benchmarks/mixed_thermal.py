@@ -163,7 +163,11 @@ def main(argv=None):
         default=1e-9,
         help="with --engagement-fine: EHLModel.tolerance, the Newton solves' ‖F‖∞",
     )
-    ap.add_argument("--rows", type=Path, help=ROWS_HELP + " (--held-steps, --engagement-transport)")
+    ap.add_argument(
+        "--rows",
+        type=Path,
+        help=ROWS_HELP + " (--held-steps, --engagement-fine, --engagement-transport)",
+    )
     args = ap.parse_args(argv)
     if args.engagement:
         return engagement()
