@@ -469,11 +469,18 @@ def engagement_grid(sizes):
     write_section("mixed_engagement_grid", body)
 
 
+def _converged_mean(sols, ok, field):
+    """A passage's ``field`` averaged over its converged steps, × the 20 mm face width (W per
+    contact for a loss per width)."""
+    import numpy as np
+
+    return float(np.sum(np.where(ok, getattr(sols, field), 0.0)) / max(ok.sum(), 1)) * 0.02
+
+
 def engagement_transport(cache):
     """The ground engagement along the path (257 nodes, Δt = Δx/ur, 700 N m) of the deterministic
     film with the Eulerian transport and along the characteristics, iso-thermal and thermal, and
     the statistical film (thermal) beside them: cost and the loss split. Rows kept in ``cache``."""
-    import numpy as np
 
     surf = jg.presets.ground()
     cases = (
@@ -499,8 +506,8 @@ def engagement_transport(cache):
         model = jg.EHLModel(n_nodes=257, **kw)
         k, t_compile, t_run, sols, ok, its, loss, _ = _march_path(model, rpm, surf)
 
-        def mean(field):  # W per contact over the 20 mm face width, over the converged steps
-            return float(np.sum(np.where(ok, getattr(sols, field), 0.0)) / max(ok.sum(), 1)) * 0.02
+        def mean(field):
+            return _converged_mean(sols, ok, field)
 
         asperity = mean("power_loss_asperity")
         fluid = mean("power_loss_sliding") - asperity
@@ -561,8 +568,8 @@ def film_transport(cache):
         model = jg.EHLModel(n_nodes=257, thermal=True, **kw)
         k, t_compile, t_run, sols, ok, its, loss, _ = _march_path(model, rpm, surf)
 
-        def mean(field):  # W per contact over the 20 mm face width, over the converged steps
-            return float(np.sum(np.where(ok, getattr(sols, field), 0.0)) / max(ok.sum(), 1)) * 0.02
+        def mean(field):
+            return _converged_mean(sols, ok, field)
 
         peak = float(np.max(np.where(ok, sols.p_max, 0.0))) / 1e9
         row = (
