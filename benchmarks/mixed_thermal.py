@@ -408,6 +408,14 @@ def engagement():
     write_section("mixed_engagement", body)
 
 
+def _converged_mean(sols, ok, field):
+    """A passage's ``field`` averaged over its converged steps, × the 20 mm face width (W per
+    contact for a loss per width)."""
+    import numpy as np
+
+    return float(np.sum(np.where(ok, getattr(sols, field), 0.0)) / max(ok.sum(), 1)) * 0.02
+
+
 def _march_path(model, rpm, surf, courant=1.0):
     """One engagement along the path (``_path_contacts``) with ``model``, compiled then run:
     (steps, compile s, run s, solutions, converged, iterations, mean loss over the converged
@@ -421,7 +429,7 @@ def _march_path(model, rpm, surf, courant=1.0):
         lambda cs, t: solve_ehl_passage(cs, LUB, model, surf, times=t), contacts, times
     )
     ok = np.asarray(sols.converged)
-    loss = float(np.sum(np.where(ok, sols.power_loss, 0.0)) / max(ok.sum(), 1)) * 0.02
+    loss = _converged_mean(sols, ok, "power_loss")
     return (
         k,
         t_compile,
@@ -467,14 +475,6 @@ def engagement_grid(sizes):
         ]
     )
     write_section("mixed_engagement_grid", body)
-
-
-def _converged_mean(sols, ok, field):
-    """A passage's ``field`` averaged over its converged steps, × the 20 mm face width (W per
-    contact for a loss per width)."""
-    import numpy as np
-
-    return float(np.sum(np.where(ok, getattr(sols, field), 0.0)) / max(ok.sum(), 1)) * 0.02
 
 
 def engagement_transport(cache):
