@@ -267,6 +267,14 @@ def test_bad_model_and_arguments_raise():
         jg.EHLModel(n_nodes=4)
     with pytest.raises(ValueError, match="EHLModel.shear"):
         jg.EHLModel(shear="carreau")
+    with pytest.raises(
+        ValueError, match=r"EHLModel\.thermal_rtol = 0 is out of range; valid range: \(0, 0\.5\]"
+    ):
+        jg.EHLModel(thermal_rtol=0.0)
+    with pytest.raises(
+        ValueError, match=r"EHLModel\.thermal_atol = -1 is out of range; valid range: \(0, 10\]"
+    ):
+        jg.EHLModel(thermal_atol=-1.0)
     c = gear_contact()
     with pytest.raises(ValueError, match="surfaces"):
         jg.solve_ehl(c, LUB, STANDARD, surfaces="ground")
