@@ -173,9 +173,10 @@ class EHLModel(eqx.Module):
             max(thermal_rtol × its largest rise, thermal_atol K) of the one it was solved with.
             Defaults 0.01 and 0.05 K. That error does not shrink with the time step: a transient
             passage's film temperature converges in Δt only with tighter values (measured on a
-            bump passing a thermal film, 129 nodes, 2000 rpm: 0.24-0.36 K apart between
-            Δt/2, Δt/4 and Δt/8 with the defaults, out of a 3.2 K rise; at 1e-4 and 1e-4 K
-            first order, 0.024 and 0.008 K, tests/test_time_scheme.py).
+            bump passing a thermal film, 129 nodes, 2000 rpm, backward Euler: 0.24 K apart
+            both between Δt/2 and Δt/8 and between Δt/4 and Δt/8 with the defaults, out of a
+            3.2 K rise; at 1e-4 and 1e-4 K first order, 0.024 and 0.008 K,
+            tests/test_time_scheme.py; raise ``thermal_iterations`` with them).
         boundary_friction: μb of asperity contact (paper: 0.1).
         contact_threshold: a node is in asperity contact where h is below this fraction of the
             smooth central-film estimate (there the Poiseuille flow has vanished: ε ∝ h³ < 1e-7 of
@@ -249,11 +250,12 @@ class EHLModel(eqx.Module):
         time_scheme: the squeeze term ∂(ρh)/∂t of a transient passage (``solve_ehl_passage``).
             "backward_euler" (default): first order. "bdf2": second-order backward differences
             on variable steps (the first transient step, and a step after a failed one, backward
-            Euler); the same residual, one more film level carried. Only the Reynolds squeeze term:
-            the film temperature's ∂ϕm/∂t and the solids' temperatures keep their first-order
-            steps (a thermal passage converges at first order in Δt with either scheme; its film
-            temperature's BDF2, tried, changed nothing there: the solids' steps dominate). A deterministic rough film's loss needs it: on the polished film at the pitch
-            contact (3500 rpm, 2049 nodes; RESULTS ``mixed_time_steps``) backward Euler at
+            Euler); the same residual, one more film level carried. Only the Reynolds squeeze
+            term: the film temperature's ∂ϕm/∂t and the solids' temperatures keep their
+            first-order steps (a thermal passage converges at first order in Δt with either
+            scheme; BDF2 for the film temperature too, tried, changed nothing there: the solids'
+            steps dominate). A deterministic rough film's loss needs it: on the polished film at
+            the pitch contact (3500 rpm, 2049 nodes; RESULTS ``mixed_time_steps``) backward Euler at
             Δt = Δx/ur is 36 % above the Δt → 0 limit, BDF2 25 % there and 6 % at Δx/(2 ur),
             with as many Newton iterations a step (both Eulerian; see ``transport``).
         transport: how a transient step discretises the film's transport u_m ∂(ρh)/∂x + ∂(ρh)/∂t.
