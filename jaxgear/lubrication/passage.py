@@ -359,8 +359,8 @@ def solve_ehl_passage(
         model: static EHLModel (``thermal=True`` for the transient temperatures).
         surfaces: None (smooth) or Surfaces (mixed; roughness moving with each surface).
         times: (K,) increasing, s. The first state is solved steadily (no squeeze; the surfaces
-            enter at the bulk temperature); each later one is a backward-Euler step from the one
-            before.
+            enter at the bulk temperature); each later one is a step of ``model.time_scheme``
+            from the ones before.
         displacement: (d1, d2) of the surfaces at ``times[0]``, m.
         solids: (Material, Material) of gears 1 and 2 (default steel).
 
