@@ -159,9 +159,10 @@ def _speed_transient_errors(model):
         # first order: 3 against Δt/8; measured 3.81 (0.076 and 0.020 K of a 5.2 K rise)
         ("backward_euler", (2.2, 4.0)),
         # second order: 5; measured 4.65 (0.022 and 0.0047 K). With the solids' and the film
-        # temperature's steps left at backward Euler it was first order (bump passage: 3.07);
-        # with BDF2 in depth but linear interpolation at the feet, 0.072 and 0.0015 K (ratio 47:
-        # the error depends on the fraction of a cell a step moves the material, not on Δt)
+        # temperature's steps left at backward Euler (the code before 2026-11-28's change) it
+        # was first order, 3.79 (0.077 and 0.020 K); with BDF2 in depth but linear
+        # interpolation at the feet, 0.072 and 0.0015 K (ratio 47: the error depends on the
+        # fraction of a cell a step moves the material, not on Δt)
         ("bdf2", (4.0, 6.5)),
     ],
 )
