@@ -259,14 +259,9 @@ def test_ehl_rung_attractor_means_follow_exact_ehl_solves_slow():
     assert float(res.power_loss) == pytest.approx(sliding + rolling, rel=0.05)
 
 
-def test_forward_mode_gradient_with_the_attractor_branch_matches_central_differences():
-    # Regression: the attractor branch closed over DynamicsOptions arrays made in the simulate
-    # trace; the JVP rule of the lazy cond re-traces the branch, so jax.jacfwd of simulate (what
-    # optimise_tip_relief uses) failed to lower with "No constant handler for type
-    # DynamicJaxprTracer" at every tribo-dynamic fidelity with attractor_periods > 0.
-    # Compiled and run, it also checks the implicit derivative of the fixed point (solved by
-    # _krylov.EarlyExitGMRES) against central differences in the default test run; the slow tests
-    # of tests/test_tribodynamics.py do so at the EHL rungs.
+def _attractor_efficiency():
+    """Ψ(tip relief, torque) of the calibrated pair at 2500 rpm, tribo-dynamic with the attractor
+    branch (constant μ, smooth backlash, 24 positions), jitted, and the point x0."""
     lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
     fid = jg.Fidelity(
         friction="constant",
@@ -283,7 +278,27 @@ def test_forward_mode_gradient_with_the_attractor_branch_matches_central_differe
         op = jg.OperatingPoint(torque=x[1], speed_rpm=2500.0, inlet_temperature=363.15)
         return jg.simulate(pair, lub, surf, op, fid).efficiency
 
-    x0 = jnp.asarray([10e-6, 700.0])
+    return eff, jnp.asarray([10e-6, 700.0])
+
+
+def test_forward_mode_through_the_attractor_branch_lowers():
+    # Regression: the attractor branch closed over DynamicsOptions arrays made in the simulate
+    # trace; the JVP rule of the lazy cond re-traces the branch, so jax.jacfwd of simulate (what
+    # optimise_tip_relief uses) failed to lower with "No constant handler for type
+    # DynamicJaxprTracer" at every tribo-dynamic fidelity with attractor_periods > 0. Lowering
+    # alone shows it (~24 s); compiling and running the derivative is the slow test below
+    # (~150 s more, nearly all compilation)
+    eff, x0 = _attractor_efficiency()
+    lowered = jax.jit(jax.jacfwd(eff)).lower(x0)
+    assert lowered.out_info.shape == (2,)
+
+
+@pytest.mark.slow
+def test_forward_mode_gradient_with_the_attractor_branch_matches_central_differences():
+    # the implicit derivative of the fixed point (solved by _krylov.EarlyExitGMRES) through the
+    # attractor branch against central differences (measured 2026-11-28: 1e-9 and 5e-7 apart);
+    # the slow tests of tests/test_tribodynamics.py do so at the EHL rungs
+    eff, x0 = _attractor_efficiency()
     g = jax.jit(jax.jacfwd(eff))(x0)
     steps = (1e-8, 0.5)  # 1e-3 and 7e-4 of the values
     fd = [(eff(x0.at[i].add(h)) - eff(x0.at[i].add(-h))) / (2.0 * h) for i, h in enumerate(steps)]
