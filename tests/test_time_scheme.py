@@ -2,6 +2,7 @@
 Euler or BDF2 for the squeeze term ∂(ρh)/∂t and, in a thermal passage, the film and solid
 temperatures) and where its roughness stands at the first state."""
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -11,6 +12,7 @@ from ehl_cases import bump_surfaces, gear_contact, held_passage
 import jaxgear as jg
 from jaxgear.lubrication.passage import (
     _advect_cubic,
+    _film_rise_at,
     _squeeze_history,
     grid_time_step,
     solve_ehl_passage,
@@ -106,23 +108,74 @@ def test_thermal_passage_of_a_bump_converges_at_first_order_with_tight_temperatu
     assert 2.2 < e2 / e4 < 4.0, (e2, e4)
 
 
-def test_cubic_advection_is_exact_for_cubics_and_empty_outside_the_grid():
+def test_cubic_advection_is_exact_for_cubics_up_to_the_ends_and_empty_outside_the_grid():
     # a BDF2 thermal passage reads the solids' earlier fields at their material points' feet by
-    # cubic Lagrange interpolation: exact for a cubic in x (to rounding) away from the grid's
-    # ends, where the repeated edge rows make it first order; 0 outside the grid (material
-    # entering at the bulk temperature), as the linear interpolation it replaces
-    x = jnp.linspace(-1.0, 2.0, 31)
+    # cubic Lagrange interpolation: exact for a cubic in x (to rounding) over the whole grid,
+    # the end cells included (the stencil shifted inwards there: with the edge rows repeated,
+    # as before 2026-11-28, it missed this cubic by 0.019 in the end cells), and up to ``extend``
+    # cells past either end; 0 further out (material entering at the bulk temperature)
+    x = jnp.linspace(-1.0, 2.0, 31)  # Δx = 0.1
     cubic = lambda s: 0.3 - s + 0.7 * s**2 - 0.4 * s**3  # noqa: E731
     field = jnp.stack([cubic(x), 2.0 * cubic(x)], axis=1)
-    feet = jnp.linspace(-0.85, 1.85, 23)  # at least one cell inside each end
+    feet = jnp.linspace(-1.0, 2.0, 47)  # end cells included
     read = _advect_cubic(field, x, feet)
     np.testing.assert_allclose(read[:, 0], cubic(feet), rtol=0, atol=1e-12)
     np.testing.assert_allclose(read[:, 1], 2.0 * cubic(feet), rtol=0, atol=1e-12)
     outside = _advect_cubic(field, x, jnp.array([-1.05, 2.05]))
     np.testing.assert_array_equal(outside, 0.0)
+    past = jnp.array([-1.09, -1.03, 2.04, 2.1])
+    np.testing.assert_allclose(
+        _advect_cubic(field, x, past, extend=1)[:, 0], cubic(past), rtol=0, atol=1e-12
+    )
+    np.testing.assert_array_equal(_advect_cubic(field, x, jnp.array([-1.11, 2.11]), extend=1), 0.0)
     # linear interpolation misses the same cubic by O(Δx²): the test can tell the two apart
     linear = jnp.interp(feet, x, cubic(x))
     assert float(jnp.max(jnp.abs(linear - cubic(feet)))) > 1e-3
+
+
+def test_film_temperature_is_read_past_the_previous_grid_by_extrapolation():
+    # the film's ∂ϕm/∂t reads the previous step's rise at this step's nodes, which lie past the
+    # previous grid's ends when the grid (following the Hertz width) grows: extrapolated there up
+    # to one cell, held beyond; exact for a line (backward Euler's linear reads) and a cubic
+    # (BDF2's cubic reads) within that cell
+    x_old = jnp.linspace(0.0, 1.0, 11)  # Δx = 0.1
+    x = jnp.array([-0.25, -0.1, -0.04, 0.0, 0.33, 1.0, 1.06, 1.1, 1.3])
+    line = lambda s: 2.0 + 3.0 * s  # noqa: E731
+    read = _film_rise_at(x, x_old, line(x_old), cubic=False)
+    expected = line(jnp.clip(x, -0.1, 1.1))
+    np.testing.assert_allclose(read, expected, rtol=0, atol=1e-13)
+    cubic = lambda s: 0.5 + s - 2.0 * s**2 + 1.5 * s**3  # noqa: E731
+    read = _film_rise_at(x, x_old, cubic(x_old), cubic=True)
+    np.testing.assert_allclose(read, cubic(jnp.clip(x, -0.1, 1.1)), rtol=0, atol=1e-12)
+
+
+def test_outlet_film_temperature_follows_its_neighbours_under_a_rising_load():
+    # A thermal smooth pitch contact (65 nodes, 2000 rpm, SRR 0.3), warmed up by 64 Δt, then 12 Δt
+    # (Δt = Δx/ur) with the load rising by 30 % as 1 − cos: the grid follows the Hertz width, so
+    # each step's outlet node lies past the previous one's. Until 2026-11-28 the previous film
+    # temperature was read as the inlet's there, and the outlet node's ∂ϕm/∂t pulled its film
+    # towards it: a rise of 2.33 K where its neighbours continue to 3.76 K (measured; 38 % off).
+    # Extrapolated from the previous grid's end nodes (``_film_rise_at``): 3.75 against 3.82 K,
+    # the rest the film's curvature at the outlet on this grid. 5 % allows for that
+    c = gear_contact(rpm=2000.0, slide_to_roll=0.3)
+    model = jg.EHLModel(n_nodes=65, thermal=True)
+    dt = float(grid_time_step(c, LUB, model))
+    t = np.arange(13) * dt
+    factor = np.concatenate([[1.0], 1.0 + 0.15 * (1.0 - np.cos(np.pi * t / (12.0 * dt)))])
+    contacts = jax.tree_util.tree_map(lambda a: jnp.full(factor.shape, a), c)
+    contacts = eqx.tree_at(
+        lambda k: k.load_per_width, contacts, jnp.asarray(float(c.load_per_width) * factor)
+    )
+    warm = 64.0 * dt
+    times = jnp.asarray(np.concatenate([[0.0], warm + t]))
+    sols = solve_ehl_passage(
+        contacts, LUB, model, times=times, displacement=(-float(c.u1) * warm, -float(c.u2) * warm)
+    )
+    assert bool(jnp.all(sols.converged))
+    rise = np.asarray(sols.temperature[-1]) - float(c.inlet_temperature)
+    assert rise[-1] > 1.0  # a hot outlet, where the pull shows
+    continued = 2.0 * rise[-2] - rise[-3]
+    assert abs(rise[-1] - continued) < 0.05 * rise[-1], (rise[-1], continued)
 
 
 def _speed_transient_errors(model):
