@@ -14,7 +14,8 @@ passage marches the EHL problem through a given sequence of contact states with 
   with memory (paper Eq. 9; :class:`~jaxgear.lubrication.thermal.SubsurfaceTemperature`, carried
   from step to step with each solid), the film temperature with its time derivative ∂ϕm/∂t; both
   by the passage's time scheme (under BDF2 the solids' earlier fields read at their material
-  points' feet by cubic interpolation, ``_advect_cubic``);
+  points' feet by cubic interpolation, ``_advect_cubic``), the film's earlier temperatures read at
+  this step's nodes and extrapolated past the earlier grid's ends (``_film_rise_at``);
 - a warm start from the previous step.
 
 The time step is the caller's choice. Tied to the grid, Δt = Δx/ur moves the roughness about one
@@ -102,7 +103,7 @@ def _film_rise_at(x, x_old, rise_old, cubic):
     past the previous step's. Read as 0 there (the inlet temperature, as before 2026-11-28), the
     outlet node's ∂ϕm/∂t pulled its film towards the inlet temperature: under a load rising by
     30 % over 24 Δx/ur (129 nodes, 2000 rpm, thermal smooth film, BDF2) its temperature rise was
-    0.12 K where its neighbour's is 2.8 K, and its error against Δt/16 fell only as Δt^0.7 (0.31,
+    0.12 K where the node two cells upstream had 2.8 K, and its error against Δt/16 fell only as Δt^0.7 (0.31,
     0.20, 0.11 K at Δt/2, Δt/4, Δt/8), the largest error of the film. The film leaves through the
     outlet, so what stood just past it continues what stood at it; at the inlet the rise is small
     either way."""
