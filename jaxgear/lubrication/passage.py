@@ -103,10 +103,10 @@ def _film_rise_at(x, x_old, rise_old, cubic):
     past the previous step's. Read as 0 there (the inlet temperature, as before 2026-11-28), the
     outlet node's ∂ϕm/∂t pulled its film towards the inlet temperature: under a load rising by
     30 % over 24 Δx/ur (129 nodes, 2000 rpm, thermal smooth film, BDF2) its temperature rise was
-    0.12 K where the node two cells upstream had 2.8 K, and its error against Δt/16 fell only as Δt^0.7 (0.31,
-    0.20, 0.11 K at Δt/2, Δt/4, Δt/8), the largest error of the film. The film leaves through the
-    outlet, so what stood just past it continues what stood at it; at the inlet the rise is small
-    either way."""
+    0.12 K where the node two cells upstream had 2.8 K, and its error against Δt/16 fell only as
+    Δt^0.7 (0.31, 0.20, 0.11 K at Δt/2, Δt/4, Δt/8), the largest error of the film. The film
+    leaves through the outlet, so what stood just past it continues what stood at it; at the inlet
+    the rise is small either way."""
     dx = x_old[1] - x_old[0]
     at = jnp.clip(x, x_old[0] - dx, x_old[-1] + dx)
     if cubic:
