@@ -64,13 +64,40 @@ def grid_time_step(contact: LineContact, lubricant: Lubricant, model: EHLModel):
     return (x[1] - x[0]) / contact.rolling_velocity
 
 
-def _advect_to(temperature, x_old, x_new, shift):
-    """T(x_new − shift) interpolated from the (n, nz) field on x_old; 0 for material entering."""
-    return jax.vmap(
-        lambda col: jnp.interp(x_new - shift, x_old, col, left=0.0, right=0.0),
-        in_axes=1,
-        out_axes=1,
-    )(temperature)
+def _advect_to(temperature, x_old, feet, cubic=False, entering=True):
+    """An earlier (n, nz) field on x_old at ``feet`` (m; a solid's material points' feet, or the
+    film's nodes): linear or cubic (``_advect_cubic``) interpolation; past the last node
+    extrapolated from the end nodes up to one cell and held beyond; before the first node 0
+    where material ``entering`` there comes at the bulk temperature (the solids), else
+    extrapolated in the same way (the film, ``_film_rise_at``).
+
+    Why past the outlet: the grid follows the Hertz width, so where the load rises fast its outlet
+    moves further in a step than the material does, and material that stood past the earlier
+    grid's outlet enters this one. Read as 0 (the bulk temperature, as before 2026-11-28), it left
+    a cold dip in the solids behind the outlet: a load doubled in one step after 100 steps of
+    Δx/ur (65 nodes, 2000 rpm, SRR 0.3, thermal smooth film, backward Euler) put the surfaces
+    0.07-0.9 K above the bulk at the 4 nodes past the old outlet where the outlet had stood at
+    2.1 K (now 1.9-2.7 K), and the dip travelled out over the next steps. That material left the
+    contact at about the outlet's temperature, and keeps it over a step: it cools by conduction
+    into the depth over many."""
+    dx = x_old[1] - x_old[0]
+    at = jnp.clip(feet, x_old[0] - dx, x_old[-1] + dx)
+    if cubic:
+        values = _advect_cubic(temperature, x_old, at, extend=1)
+    else:
+        inside = jax.vmap(lambda col: jnp.interp(at, x_old, col), in_axes=1, out_axes=1)(
+            temperature
+        )
+        before = temperature[0] + (at - x_old[0])[:, None] * (temperature[1] - temperature[0]) / dx
+        after = (
+            temperature[-1] + (at - x_old[-1])[:, None] * (temperature[-1] - temperature[-2]) / dx
+        )
+        values = jnp.where(
+            (at < x_old[0])[:, None], before, jnp.where((at > x_old[-1])[:, None], after, inside)
+        )
+    if entering:
+        values = jnp.where((feet < x_old[0])[:, None], 0.0, values)
+    return values
 
 
 def _advect_cubic(temperature, x_old, feet, extend=0):
@@ -107,20 +134,14 @@ def _film_rise_at(x, x_old, rise_old, cubic):
     Δt^0.7 (0.31, 0.20, 0.11 K at Δt/2, Δt/4, Δt/8), the largest error of the film. The film
     leaves through the outlet, so what stood just past it continues what stood at it; at the inlet
     the rise is small either way."""
-    dx = x_old[1] - x_old[0]
-    at = jnp.clip(x, x_old[0] - dx, x_old[-1] + dx)
-    if cubic:
-        return _advect_cubic(rise_old[:, None], x_old, at, extend=1)[:, 0]
-    inside = jnp.interp(at, x_old, rise_old)
-    before = rise_old[0] + (at - x_old[0]) * (rise_old[1] - rise_old[0]) / dx
-    after = rise_old[-1] + (at - x_old[-1]) * (rise_old[-1] - rise_old[-2]) / dx
-    return jnp.where(at < x_old[0], before, jnp.where(at > x_old[-1], after, inside))
+    return _advect_to(rise_old[:, None], x_old, x, cubic, entering=False)[:, 0]
 
 
 def _temperature_start(mixed, prev, x, inlet, shift):
     """The film temperature rise (K, on this step's nodes ``x``) a step's temperature iteration
     starts from: the previous step's solution ``prev``, and, with deterministic roughness, moved
-    downstream by ``shift`` = ur Δt.
+    downstream by ``shift`` = ur Δt (the inlet at 0). Read as the film's ∂ϕm/∂t reads it past the
+    previous grid's outlet (``_advect_to``; 0 there before 2026-11-28).
 
     Why: a deterministic rough film's hot spots stand at its asperity contacts and thin films, which
     move with the surfaces, about one cell a step (Δt = Δx/ur); left where they were, the
@@ -140,10 +161,10 @@ def _temperature_start(mixed, prev, x, inlet, shift):
     converged, in the iso-thermal passage 129 and 255 of 288 (the cold solve there: 97);
     temperatures smoothed over 9 cells at the start of the cold solve's roughness continuation:
     155 against 174 iterations a cold solve, 61.9 against 62.0 s."""
-    rise = prev.temperature - inlet
+    rise = (prev.temperature - inlet)[:, None]
     if mixed != "deterministic":
-        return jnp.interp(x, prev.x, rise, left=0.0, right=0.0)
-    return jnp.interp(x - shift, prev.x, rise, left=0.0, right=0.0)
+        return _advect_to(rise, prev.x, x, entering=False)[:, 0]
+    return _advect_to(rise, prev.x, x - shift)[:, 0]
 
 
 def _squeeze_history(model, rho_h_prev, inv_dt, older, usable, dt, read_older):
@@ -259,11 +280,13 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         for k, temp in enumerate((temp1, temp2)):
             if bdf2 and not first:
                 start_temp = blend(
-                    _advect_cubic(temp, prev.x, x - solid_shift[k]),
-                    _advect_cubic(older[6 + k], older[0], x - solid_shift[k] - older[8][k]),
+                    _advect_to(temp, prev.x, x - solid_shift[k], cubic=True),
+                    _advect_to(
+                        older[6 + k], older[0], x - solid_shift[k] - older[8][k], cubic=True
+                    ),
                 )
             else:
-                start_temp = _advect_to(temp, prev.x, x, solid_shift[k])
+                start_temp = _advect_to(temp, prev.x, x - solid_shift[k])
             state = thermal_mod.SubsurfaceTemperature(temperature=start_temp, depth=depth)
             frees.append(thermal_mod.transient_predict(state, dx, 0.0, dt / a0, solids[k]))
         response = tuple((f[:, 0], jnp.full_like(x, g[0])) for f, g in frees)
