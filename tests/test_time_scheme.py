@@ -340,17 +340,60 @@ def test_film_at_the_feet_reads_the_roughness_where_it_stood():
     foot = x - shift
     exact = density(foot) * (gap(foot) + _roughness_offset("deterministic", surf, foot, d))
     model = jg.EHLModel(transport="characteristic")
-    read = _film_at_feet(model, "deterministic", surf, x, shift, x_prev, rho_h, density(x_prev), d)
+    radius = 0.02
+    args = (x_prev, rho_h, density(x_prev), d, radius)
+    read = _film_at_feet(model, "deterministic", surf, x, shift, *args)
     scale = 850.0 * amplitude
-    inside = foot >= x_prev[0]  # upstream of the inlet node the smooth part is extrapolated
-    assert float(jnp.max(jnp.abs(read - exact)[inside])) < 1e-2 * scale
+    # upstream of the inlet node too (the first foot lies 0.06 b before it): the rigid gap and the
+    # roughness are put back there, the rest extrapolated
+    assert float(jnp.max(jnp.abs(read - exact))) < 1e-2 * scale
     plain = jnp.interp(foot, x_prev, rho_h)
+    inside = foot >= x_prev[0]
     assert float(jnp.max(jnp.abs(plain - exact)[inside])) > 0.1 * scale
-    # the Eulerian term reads the previous film at the nodes themselves
-    eulerian = _film_at_feet(
-        jg.EHLModel(), "deterministic", surf, x, shift, x_prev, rho_h, density(x_prev), d
+    # the Eulerian term reads the previous film at the nodes themselves: interpolated inside the
+    # previous grid, and upstream of it (the grid grown with the load) the rigid gap put back
+    eulerian = _film_at_feet(jg.EHLModel(), "deterministic", surf, x, shift, *args)
+    np.testing.assert_array_equal(eulerian[1:], jnp.interp(x[1:], x_prev, rho_h))
+    at_nodes = density(x) * (gap(x) + _roughness_offset("deterministic", surf, x, d))
+    assert float(x[0]) < float(x_prev[0])
+    assert abs(float(eulerian[0] - at_nodes[0])) < 1e-2 * scale
+    # held at the first node's value (as before 2026-11-28) it missed the gap's growth over 0.045 b
+    assert abs(float(rho_h[0] - at_nodes[0])) > 0.1 * scale
+
+
+def test_a_grown_grid_reads_the_earlier_film_upstream_of_its_inlet_with_the_rigid_gap():
+    # A load doubled in one step widens the grid (it follows the Hertz width) by ~40 %: the earlier
+    # film is read 2 b upstream of its first node. A smooth earlier film ρ (h0 + x²/2R + v(x)),
+    # v a slowly varying deformation (linear far upstream) and ρ the inlet's: read there within
+    # 1e-3 of its gap growth (the deformation's curvature, 1e-4 of the gap, is what linear
+    # extrapolation misses); held at the first node's value, as before, 30 % of it short
+    from jaxgear.lubrication.ehl import _film_at_feet
+
+    b, radius, rho0 = 300e-6, 0.013, 870.0
+    x_prev = jnp.linspace(-4.5 * b, 1.5 * b, 257)
+    x = jnp.linspace(-6.4 * b, 2.1 * b, 257)
+
+    def film(s):
+        return rho0 * (2e-7 + s**2 / (2.0 * radius) + 1e-8 * (1.0 + s / b) + 1e-12 * (s / b) ** 2)
+
+    read = _film_at_feet(
+        jg.EHLModel(),
+        "smooth",
+        None,
+        x,
+        0.0,
+        x_prev,
+        film(x_prev),
+        jnp.full(257, rho0),
+        None,
+        radius,
     )
-    np.testing.assert_array_equal(eulerian, jnp.interp(x, x_prev, rho_h))
+    before = x < x_prev[0]
+    growth = film(x) - film(x_prev[0])
+    err = jnp.abs(read - film(x))
+    assert float(jnp.max(err[before] / jnp.abs(growth[before]))) < 1e-3
+    held = jnp.interp(x, x_prev, film(x_prev))
+    assert float(jnp.max(jnp.abs(held - film(x))[before] / film(x)[before])) > 0.3
 
 
 @pytest.mark.parametrize(("courant", "exact"), [(1.0, True), (0.5, True), (2.0, False)])

@@ -228,8 +228,9 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         prev_ok = prev_ok & jnp.all(jnp.isfinite(prev.temperature))
         # along the characteristics (``EHLModel.transport``) the previous films are read where
         # the mean velocity carried them from: x − ∫ ur dt
+        radius = contact.reduced_radius
         rho_h_prev = _film_at_feet(
-            model, mixed, surfaces, x, shift, prev.x, prev.rho_h, prev.density, d_prev
+            model, mixed, surfaces, x, shift, prev.x, prev.rho_h, prev.density, d_prev, radius
         )
         rho_h_prev = jnp.where(prev_ok, rho_h_prev, 0.0)
         inv_dt = jnp.where(prev_ok, 1.0 / dt, 0.0)
@@ -238,7 +239,16 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
             # step n − 1, carried along the characteristics over that step and this one
             x_old, rho_h_old, rho_old, d_old, shift_old = older[:5]
             return _film_at_feet(
-                model, mixed, surfaces, x, shift + shift_old, x_old, rho_h_old, rho_old, d_old
+                model,
+                mixed,
+                surfaces,
+                x,
+                shift + shift_old,
+                x_old,
+                rho_h_old,
+                rho_old,
+                d_old,
+                radius,
             )
 
         inv_dt, rho_h_prev = _squeeze_history(
