@@ -32,6 +32,9 @@ def test_fidelity_coupling_field():
     assert Fidelity.paper().fixed_point_rtol == 3e-3
 
 
+# slow since 2026-11-28 (~82 s, two compiled simulations): the default run took 19.1 min from a
+# fresh clone in a slow hour
+@pytest.mark.slow
 def test_frozen_equals_fixed_point_for_constant_mu(setup):
     # With a constant μ, Fs = μ W s(us) is exactly the frozen scaling of the quasi-static
     # coefficient Fs/(W s) = μ, so both couplings have the same fixed point: the same dynamics,

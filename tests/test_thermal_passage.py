@@ -7,6 +7,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 from ehl_cases import gear_contact
 
 import jaxgear as jg
@@ -76,6 +77,8 @@ def test_a_deterministic_steps_temperature_start_is_the_previous_film_temperatur
     np.testing.assert_allclose(held, spot(0.0), atol=1e-9)
 
 
+# slow since 2026-11-28 (~38 s): the default run took 19.1 min from a fresh clone in a slow hour
+@pytest.mark.slow
 def test_the_thermal_deterministic_passage_does_not_depend_on_where_its_temperature_iteration_starts(
     monkeypatch,
 ):
