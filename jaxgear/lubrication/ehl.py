@@ -649,15 +649,15 @@ def _film_at_feet(model, mixed, surfaces, x, shift, x_prev, rho_h, rho, d, radiu
     load; or a foot upstream of the inlet) the rigid gap x²/(2R) (``radius`` R, this step's) and
     the roughness are taken out, the rest (h0, the deformation: slowly varying there) extrapolated
     linearly, and the gap and the roughness there put back at the first node's density (the
-    inlet's pressure is ~0). Why: held at the first
-    node's value, as before 2026-11-28, the earlier film was read too thin by the gap's growth
-    there, and the squeeze term filled a gap that was not opening. Where the load doubles in a step
-    of a third of a Hertz width (the coupled transient rung's jumps; 257 nodes, 3500 rpm, smooth,
-    iso-thermal) the inlet moves 56 cells; that step's loss was 0.5 % lower (16 586 against
-    16 669 W/m), its film the same to 1e-4, the later steps' losses within 2e-5. Inside the
-    earlier grid ρh is interpolated as it is: in the Hertz zone the deformation cancels the rigid
-    gap's curvature, so taking the gap out there would make the rest curved (a one-off run that
-    did moved the same step's loss by another 0.4 % and its central film by 0.1 %)."""
+    inlet's pressure is ~0). Why: held at the first node's value, as before 2026-11-28, the
+    earlier film was read too thin by the gap's growth there, and the squeeze term filled a gap
+    that was not opening. Where the load doubles in a step of a third of a Hertz width (the
+    coupled transient rung's jumps; 257 nodes, 3500 rpm, smooth, iso-thermal) the inlet moves 56
+    cells; that step's loss was 0.5 % lower (16 586 against 16 669 W/m), its film the same to
+    1e-4, the later steps' losses within 2e-5. Inside the earlier grid ρh is interpolated as it
+    is: in the Hertz zone the deformation cancels the rigid gap's curvature, so taking the gap out
+    there would make the rest curved (a one-off run that did so moved the same step's loss by
+    another 0.4 % and its central film by 0.1 %)."""
     foot = x - shift if model.transport == "characteristic" else x
     offset_prev = _roughness_offset(mixed, surfaces, x_prev, d)
     rest_prev = rho_h - rho * offset_prev
