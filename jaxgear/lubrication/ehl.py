@@ -662,16 +662,15 @@ def _film_at_feet(model, mixed, surfaces, x, shift, x_prev, rho_h, rho, d, radiu
     offset_prev = _roughness_offset(mixed, surfaces, x_prev, d)
     rest_prev = rho_h - rho * offset_prev
     gap_prev = rho * x_prev**2 / (2.0 * radius)
+    offset_foot = _roughness_offset(mixed, surfaces, foot, d)
     upstream = _extrapolated_interp(foot, x_prev, rest_prev - gap_prev) + rho[0] * (
-        foot**2 / (2.0 * radius) + _roughness_offset(mixed, surfaces, foot, d)
+        foot**2 / (2.0 * radius) + offset_foot
     )
     if model.transport != "characteristic":
         inside = jnp.interp(foot, x_prev, rho_h)
     else:
         rho_foot = _extrapolated_interp(foot, x_prev, rho)
-        inside = jnp.interp(foot, x_prev, rest_prev) + rho_foot * _roughness_offset(
-            mixed, surfaces, foot, d
-        )
+        inside = jnp.interp(foot, x_prev, rest_prev) + rho_foot * offset_foot
     return jnp.where(foot < x_prev[0], upstream, inside)
 
 
