@@ -257,7 +257,7 @@ def check_top_level(cfg: dict[str, Any], allowed: tuple[str, ...]) -> None:
 SWEEP_TABLES = ("gear", "lubricant", "surfaces", "operating", "fidelity", "sweep")
 LUBRICANT_PRESETS = ("mil_l_23699", "iso_vg68")
 SURFACE_PRESETS = ("ground", "polished", "smooth")
-FIDELITY_PRESETS = ("fast", "paper", "auto")
+FIDELITY_PRESETS = ("fast", "paper", "paper_calibrated", "auto")
 _SURFACE_KEYS = {
     "preset": str,
     "scale": float,
@@ -396,7 +396,7 @@ def _fidelity_keys() -> dict:
 
 
 def fidelity_from_config(cfg: dict[str, Any], preset: str | None = None):
-    """``[fidelity]``: ``preset`` ("fast", "paper" or "auto"; ``preset`` given here, e.g. from the
+    """``[fidelity]``: ``preset`` ("fast", "paper", "paper_calibrated" or "auto"; ``preset`` given here, e.g. from the
     command line, wins) and any ``jg.Fidelity`` field to override (``n_positions = 24``,
     ``dynamics = "quasi_static"``...).
 

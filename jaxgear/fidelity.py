@@ -23,6 +23,10 @@ DYNAMICS_RUNGS = ("quasi_static", "tribo_dynamic")
 FRICTION_RUNGS = ("constant", "regression", "ehl_formula", "ehl_smooth", "ehl_mixed")
 COUPLING_RUNGS = ("frozen", "fixed_point")
 STIFFNESS_METHODS = ("potential_energy", "iso")
+#: ``Fidelity.paper_calibrated()``'s contact: the fluid traction law and the Greenwood-Tripp
+#: density product nβσ calibrated to the paper's quasi-static loss level (see its docstring)
+CALIBRATED_SHEAR = "eyring_split"
+CALIBRATED_DENSITY_PRODUCT = 0.08
 
 
 def _static(default):
@@ -210,10 +214,15 @@ class Fidelity(eqx.Module):
         surface temperatures' memory), 32 positions per mesh cycle, 257 nodes per contact.
 
         Difference from the paper, stated: the roughness enters through the statistical
-        (Greenwood-Tripp) asperity model, not the measured profiles in the film (the deterministic
-        solver exists, ``mixed_model="deterministic"``, but does not converge at the paper's film
-        parameter λ ≈ 0.1-0.4, and the transient rung refuses it: between two mesh positions the
-        profiles would move by far more than a grid cell).
+        (Greenwood-Tripp) asperity model, not the measured profiles in the film. The deterministic
+        solver exists (``mixed_model="deterministic"``) and converges on the paper's ground
+        surfaces, but the transient rung refuses it: between two mesh positions the profiles would
+        move by far more than a grid cell, and its film is not grid-converged on grids a coupled
+        run can afford (README, known open points: Deterministic roughness).
+
+        The open contact parameters (``asperity_density_product``, ``shear``) keep their literal
+        defaults here, which put Φ̄ at 0.28-0.60 of the paper's; ``paper_calibrated()`` is the
+        same model with them set to the paper's loss level.
         """
         base = dict(
             dynamics="tribo_dynamic",
@@ -226,6 +235,39 @@ class Fidelity(eqx.Module):
         _check_fields(changes)
         base.update(changes)
         return cls(**base)
+
+    @classmethod
+    def paper_calibrated(cls, **changes) -> Fidelity:
+        """``paper()`` with its two open contact parameters calibrated to the paper's loss level:
+        the Eyring stress as the fluid traction (``shear="eyring_split"``) and the
+        Greenwood-Tripp density product nβσ = 0.08 (``asperity_density_product``; 0.05 in
+        ``paper()``). A fitted preset, like the calibrated blanks of
+        ``presets.li2015_pair_calibrated()``: use it to study the paper's trends at the paper's
+        loss level, not as a check of that level.
+
+        What was fitted and what was not (benchmarks/RESULTS.md, shear_trends_asperity, and
+        README, known open points):
+
+        - nβσ, a parameter the paper leaves open (REFERENCE §6), was raised to the top of its
+          typical range so that the quasi-static Φ̄ at A, B, D, E meets the paper's (296, 310,
+          490, 511 W against 276, 302, 526, 532 W: −7 … +7 %).
+        - The shear law is argued, not fitted: the paper's η* = η/cosh(τm/τ0) is the tangent
+          viscosity of Eyring shear, right as the flow coefficient and the damping but below the
+          Eyring stress τm as a traction; "eyring_split" keeps η* for the first and takes τm for
+          the traction and sliding heat.
+        - Then, not fitted: Ψ = 99.73-99.79 % at 1000-4200 rpm, inside the paper's band (R4);
+          iso-thermal above thermal by a gap growing with speed, 1.02 / 1.05 / 1.09 (R5); 60 °C
+          below 90 °C (R6); polished below ground (R8); the tribo-dynamic loss above the
+          quasi-static one at B and E and below it at D (R3; E +5.9 % over the attractor, where the
+          paper has +78 %).
+        - Still not the paper's: A nearly equal (−0.2 %, the paper −7 %); 1500 N m raises Ψ by
+          0.01-0.03 points (R7: the paper's is slightly lower); the rolling share reaches 9 % at
+          4200 rpm (R9; 15 % with ``paper()``).
+        """
+        base = dict(shear=CALIBRATED_SHEAR, asperity_density_product=CALIBRATED_DENSITY_PRODUCT)
+        _check_fields(changes)
+        base.update(changes)
+        return cls.paper(**base)
 
     @classmethod
     def auto(cls, pair, lubricant, surfaces, op, tolerance: float = 0.05, **options) -> Fidelity:
@@ -241,8 +283,9 @@ class Fidelity(eqx.Module):
 
     @classmethod
     def named(cls, name: str, **changes) -> Fidelity:
-        """A preset by name: "fast" or "paper" (the names the command line accepts)."""
-        presets = {"fast": cls.fast, "paper": cls.paper}
+        """A preset by name: "fast", "paper" or "paper_calibrated" (the names the command line
+        accepts)."""
+        presets = {"fast": cls.fast, "paper": cls.paper, "paper_calibrated": cls.paper_calibrated}
         if name not in presets:
             raise ValueError(
                 f"fidelity = {name!r} is not valid; valid choices: {', '.join(map(repr, presets))}"

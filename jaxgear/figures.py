@@ -585,8 +585,25 @@ def _subtitle(repro):
     thermal = "thermal" if fid.thermal else "iso-thermal"
     quick = ", quick run" if repro.quick else ""
     return (
-        f"jaxgear, friction {fid.friction!r}, {thermal}, {fid.n_positions} positions/cycle{quick}"
+        f"jaxgear, friction {fid.friction!r}, {thermal}, {fid.n_positions} positions/cycle"
+        f"{_contact_parameters(fid)}{quick}"
     )
+
+
+def _contact_parameters(fid):
+    """The open contact parameters where they differ from the defaults (e.g. those of
+    ``Fidelity.paper_calibrated()``), as ", shear 'eyring_split', nβσ 0.08"; else ""."""
+    default = type(fid)()
+    parts = []
+    if fid.shear != default.shear:
+        parts.append(f"shear {fid.shear!r}")
+    if fid.asperity_density_product != default.asperity_density_product:
+        parts.append(f"nβσ {fid.asperity_density_product:g}")
+    if fid.asperity_slope_ratio != default.asperity_slope_ratio:
+        parts.append(f"σ/β {fid.asperity_slope_ratio:g}")
+    if fid.boundary_friction != default.boundary_friction:
+        parts.append(f"μb {fid.boundary_friction:g}")
+    return "".join(", " + p for p in parts)
 
 
 def _fig3(repro):

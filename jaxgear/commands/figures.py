@@ -26,9 +26,10 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--fidelity",
-        choices=("fast", "paper"),
+        choices=("fast", "paper", "paper_calibrated"),
         default="fast",
-        help="fidelity preset (default fast)",
+        help="fidelity preset (default fast); paper_calibrated: the paper fidelity with its open "
+        "contact parameters calibrated to the paper's loss level (jg.Fidelity.paper_calibrated)",
     )
     p.add_argument("--out", type=Path, default=Path("results/figures"), help="output directory")
     p.add_argument("--quick", action="store_true", help="reduced run (seven speeds, 24 positions)")

@@ -61,7 +61,7 @@ def register(sub) -> None:
     p.add_argument("--surfaces", choices=("ground", "polished", "smooth"), default="ground")
     p.add_argument(
         "--fidelity",
-        choices=("fast", "paper", "auto"),
+        choices=("fast", "paper", "paper_calibrated", "auto"),
         default="fast",
         help="fidelity (default fast); auto: the cheapest rungs whose measured error stays under "
         "--tolerance over this sweep (jg.Fidelity.auto), with its reasons printed",
