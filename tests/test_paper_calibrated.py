@@ -54,9 +54,9 @@ def test_figures_name_the_contact_parameters_that_differ_from_the_defaults():
 def test_tribo_dynamic_loss_above_quasi_static_at_e_and_efficiency_in_the_papers_band():
     """Point E (3500 rpm, ground, 700 N m, 90 °C) at the full calibrated fidelity.
 
-    Measured 2026-11-26 (benchmarks/RESULTS.md, shear_trends_asperity): tribo-dynamic 542 W over
-    the attractor (status 6: the teeth rattle there), quasi-static 511 W (+5.9 %; the paper 948
-    against 532 W, +78 %). Margin: the tribo-dynamic loss must lie above the quasi-static one by
+    Measured 2026-11-28: tribo-dynamic 542.9 W over the attractor (status 6: the teeth rattle
+    there), quasi-static 511.3 W (+6.2 %; +5.9 % on 2026-11-26, benchmarks/RESULTS.md,
+    shear_trends_asperity; the paper 948 against 532 W, +78 %); Ψ 99.79 % and 99.80 %. Margin: the tribo-dynamic loss must lie above the quasi-static one by
     more than 2 %, twice the ~1e-3 reproducibility of the contacts' Picard loops and the attractor
     mean's sampling (64 of 256 recorded cycles), and the efficiency inside the paper's 99.6-99.85 %.
     With ``Fidelity.paper()``'s literal contact the same point gives −4 to −8 % (README)."""
