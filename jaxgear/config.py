@@ -396,9 +396,9 @@ def _fidelity_keys() -> dict:
 
 
 def fidelity_from_config(cfg: dict[str, Any], preset: str | None = None):
-    """``[fidelity]``: ``preset`` ("fast", "paper", "paper_calibrated" or "auto"; ``preset`` given here, e.g. from the
-    command line, wins) and any ``jg.Fidelity`` field to override (``n_positions = 24``,
-    ``dynamics = "quasi_static"``...).
+    """``[fidelity]``: ``preset`` ("fast", "paper", "paper_calibrated" or "auto"; ``preset``
+    given here, e.g. from the command line, wins) and any ``jg.Fidelity`` field to override
+    (``n_positions = 24``, ``dynamics = "quasi_static"``...).
 
     Returns (Fidelity, echo). With preset "auto" the Fidelity is the *base* of the choice: its
     ladder fields (physics axes and resolution) must be left out, since ``Fidelity.auto`` sets
