@@ -51,6 +51,7 @@ from typing import Any
 
 import numpy as np
 
+from .fidelity import NAMED_PRESETS
 from .gear.pair import Bearings, GearPair, TipRelief
 
 _GEAR_KEYS = {
@@ -257,7 +258,7 @@ def check_top_level(cfg: dict[str, Any], allowed: tuple[str, ...]) -> None:
 SWEEP_TABLES = ("gear", "lubricant", "surfaces", "operating", "fidelity", "sweep")
 LUBRICANT_PRESETS = ("mil_l_23699", "iso_vg68")
 SURFACE_PRESETS = ("ground", "polished", "smooth")
-FIDELITY_PRESETS = ("fast", "paper", "paper_calibrated", "auto")
+FIDELITY_PRESETS = (*NAMED_PRESETS, "auto")
 _SURFACE_KEYS = {
     "preset": str,
     "scale": float,

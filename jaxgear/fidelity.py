@@ -27,6 +27,8 @@ STIFFNESS_METHODS = ("potential_energy", "iso")
 #: density product nβσ calibrated to the paper's quasi-static loss level (see its docstring)
 CALIBRATED_SHEAR = "eyring_split"
 CALIBRATED_DENSITY_PRODUCT = 0.08
+#: the presets ``Fidelity.named`` (and so the command line and TOML) accept
+NAMED_PRESETS = ("fast", "paper", "paper_calibrated")
 
 
 def _static(default):
@@ -267,10 +269,10 @@ class Fidelity(eqx.Module):
           4200 rpm (R9; 15 % with ``paper()``); the film temperature rise at 25° is the same at B
           and E (R11).
         """
-        base = dict(shear=CALIBRATED_SHEAR, asperity_density_product=CALIBRATED_DENSITY_PRODUCT)
-        _check_fields(changes)
-        base.update(changes)
-        return cls.paper(**base)
+        calibrated = dict(
+            shear=CALIBRATED_SHEAR, asperity_density_product=CALIBRATED_DENSITY_PRODUCT
+        )
+        return cls.paper(**{**calibrated, **changes})
 
     @classmethod
     def auto(cls, pair, lubricant, surfaces, op, tolerance: float = 0.05, **options) -> Fidelity:
@@ -288,12 +290,12 @@ class Fidelity(eqx.Module):
     def named(cls, name: str, **changes) -> Fidelity:
         """A preset by name: "fast", "paper" or "paper_calibrated" (the names the command line
         accepts)."""
-        presets = {"fast": cls.fast, "paper": cls.paper, "paper_calibrated": cls.paper_calibrated}
-        if name not in presets:
+        if name not in NAMED_PRESETS:
             raise ValueError(
-                f"fidelity = {name!r} is not valid; valid choices: {', '.join(map(repr, presets))}"
+                f"fidelity = {name!r} is not valid; valid choices: "
+                f"{', '.join(map(repr, NAMED_PRESETS))}"
             )
-        return presets[name](**changes)
+        return getattr(cls, name)(**changes)
 
     @property
     def fixed_point_rtol(self) -> float:

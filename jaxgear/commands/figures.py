@@ -17,6 +17,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from jaxgear.fidelity import NAMED_PRESETS
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -26,7 +28,7 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--fidelity",
-        choices=("fast", "paper", "paper_calibrated"),
+        choices=NAMED_PRESETS,
         default="fast",
         help="fidelity preset (default fast); paper_calibrated: the paper fidelity with its open "
         "contact parameters calibrated to the paper's loss level (jg.Fidelity.paper_calibrated)",

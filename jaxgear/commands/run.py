@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from jaxgear.config import FIDELITY_PRESETS
+
 #: Most speeds one run takes (the paper's sweep has 149).
 MAX_SPEEDS = 100_000
 
@@ -61,7 +63,7 @@ def register(sub) -> None:
     p.add_argument("--surfaces", choices=("ground", "polished", "smooth"), default="ground")
     p.add_argument(
         "--fidelity",
-        choices=("fast", "paper", "paper_calibrated", "auto"),
+        choices=FIDELITY_PRESETS,
         default="fast",
         help="fidelity (default fast); auto: the cheapest rungs whose measured error stays under "
         "--tolerance over this sweep (jg.Fidelity.auto), with its reasons printed",

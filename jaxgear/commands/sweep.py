@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from jaxgear.config import FIDELITY_PRESETS
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -29,7 +31,7 @@ def register(sub) -> None:
     p.add_argument("--out", type=Path, default=Path("results"), help="output directory")
     p.add_argument(
         "--fidelity",
-        choices=("fast", "paper", "paper_calibrated", "auto"),
+        choices=FIDELITY_PRESETS,
         help="fidelity preset; overrides [fidelity] preset (its other keys still apply); auto: "
         "the cheapest rungs whose measured error stays under [fidelity] tolerance (default 0.05) "
         "over the sweep's speeds (jg.choose_fidelity), with its reasons printed",
