@@ -255,8 +255,9 @@ class EHLModel(eqx.Module):
             two earlier fields read at their material points' feet by cubic interpolation: a
             thermal passage then converges at second order in Δt on a fixed grid (a speed
             transient, tests/test_time_scheme.py: backward Euler's 0.076 / 0.020 K at Δt/2 /
-            Δt/4 against Δt/8, BDF2's 0.022 / 0.0047 K), once the start from cold is behind it
-            (a flux switched on heats the solids as √t) and with tight ``thermal_rtol``. A
+            Δt/4 against Δt/8, BDF2's 0.022 / 0.0047 K) and on the grid a load transient moves
+            (0.0027 / 0.00057 K), once the material that saw the start from cold has left the
+            contact (a flux switched on heats the solids as √t) and with tight ``thermal_rtol``. A
             deterministic rough film's loss needs it: on the polished film at
             the pitch contact (3500 rpm, 2049 nodes; RESULTS ``mixed_time_steps``) backward Euler at
             Δt = Δx/ur is 36 % above the Δt → 0 limit, BDF2 25 % there and 6 % at Δx/(2 ur),
