@@ -48,6 +48,7 @@ MODEL_KEYS = {
     "warm_iterations": int,
     "deformation": str,
     "wedge_order": int,
+    "hardness": float,
 }
 SCALARS = (
     "h_min",

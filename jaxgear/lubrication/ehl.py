@@ -70,6 +70,10 @@ TRANSPORT_SCHEMES = ("eulerian", "characteristic")
 
 _LOG_VISCOSITY_CAP = 500.0  # cap on ln(η/η0): keeps iterates finite (η/η0 ≤ e^500)
 _FLOOR_FRACTION = 1e-3  # smooth film floor inside ε, relative to the reference film
+# smoothing of the pressure limit's kink P = min(v, P_cap) (``EHLModel.hardness``), in ph
+_PLASTIC_SMOOTHING = 1e-4
+# plastic gap per unit of v above the limit, × the reference film H_ref (the unknowns' scaling)
+_PLASTIC_GAP_SCALE = 1.0
 
 
 # -------------------------------------------------------------------------------------------------
@@ -284,6 +288,16 @@ class EHLModel(eqx.Module):
             the minimum film moves by ≤ 2 % up to C Δx = 0.05 b (513 nodes, C ≤ 4), by 6 % at
             0.09 b (513, C = 8), and by 85 % at 0.19 b (129, C = 4); the coupled model's
             transient rung, a third of a Hertz width a step, is no place for it.
+        hardness: None (default: elastic solids, no bound on the pressure) or the pressure at
+            which the surfaces yield, Pa (elastic-perfectly plastic; ~7e9 for case-hardened gear
+            steel, about three times its yield stress). Where the pressure reaches it, it stays
+            there and the gap opens by a plastic gap δ ≥ 0 (``EHLSolution.plastic_gap``) that
+            keeps the Reynolds equation, so the flow, at every node: P and δ complementary,
+            through one unknown per node (``_Level.plastic``). It bounds the asperity pressure of
+            deterministic roughness, where an elastic half-space puts none (13.5 GPa on the
+            ground surfaces at 500 rpm on 1025 nodes). A passage does not carry δ from step to
+            step: each step's surfaces start elastic (no run-in memory). The statistical
+            asperity pressure (``mixed="statistical"``) is outside it.
     """
 
     n_nodes: int = eqx.field(static=True, default=257)
@@ -319,6 +333,7 @@ class EHLModel(eqx.Module):
     linear_solver: str = eqx.field(static=True, default="dense")
     time_scheme: str = eqx.field(static=True, default="backward_euler")
     transport: str = eqx.field(static=True, default="eulerian")
+    hardness: float | None = eqx.field(static=True, default=None)
 
     def __check_init__(self):
         if not isinstance(self.n_nodes, int) or self.n_nodes < 17:
@@ -350,6 +365,8 @@ class EHLModel(eqx.Module):
                 1.0,
                 low_inclusive=False,
             )
+        if self.hardness is not None:
+            check_range("EHLModel.hardness", self.hardness, 1e8, 1e11)
         check_range("EHLModel.fb_smoothing", self.fb_smoothing, 0.0, 1e-2, low_inclusive=False)
         check_range("EHLModel.tolerance", self.tolerance, 0.0, 1e-2, low_inclusive=False)
         check_range("EHLModel.thermal_rtol", self.thermal_rtol, 0.0, 0.5, low_inclusive=False)
@@ -428,6 +445,8 @@ class EHLSolution(eqx.Module):
             power_loss_rolling: Poiseuille part; power_loss_asperity: the asperity part alone.
         contact_fraction: share of the Hertz zone |x| ≤ b in asperity contact.
         contact_load: ∫ p dx over contact nodes, N/m (``contact_load_share``: its share).
+        plastic_gap: the gap the yielded surfaces opened where p reached ``EHLModel.hardness``,
+            m (included in h; zero without a hardness).
         load_error: (∫ p dx − w')/w'.
         hertz_half_width (m), hertz_pressure (Pa), moes_m, moes_l: scales of the contact;
             moes_film: Moes' central-film estimate for them, m (the reference a warm start scales).
@@ -466,6 +485,7 @@ class EHLSolution(eqx.Module):
     power_loss_asperity: Float[Array, ""]
     contact_fraction: Float[Array, ""]
     contact_load: Float[Array, ""]
+    plastic_gap: Float[Array, " N"]
     load_error: Float[Array, ""]
     hertz_half_width: Float[Array, ""]
     hertz_pressure: Float[Array, ""]
@@ -747,7 +767,28 @@ class _Level(eqx.Module):
 
     def rho_h(self, u):
         """ρ̄H at the nodes for the state u (what the squeeze term of the next step reads)."""
-        return self.density(u[: self.n]) * self.film(u)
+        return self.density(self.plastic(u[: self.n])[0]) * self.film(u)
+
+    def plastic(self, v):
+        """(P, δ) of the pressure unknowns v: the pressure and the dimensionless plastic gap.
+
+        Without a pressure limit (``EHLModel.hardness`` None) P = v and δ is None. With one,
+        P = min(v, P_cap) and δ = c H_ref max(v − P_cap, 0) (c = ``_PLASTIC_GAP_SCALE``,
+        both smoothed over ``_PLASTIC_SMOOTHING``): where the surface yields, its pressure stays at the limit and the
+        gap opens by δ ≥ 0 (the asperity flattened), complementary to P_cap − P ≥ 0. The Reynolds
+        equation holds at every node, plastic ones included, so the flow is conserved there."""
+        if self.model.hardness is None:
+            return v, None
+        cap = self.model.hardness / self.sc.ph
+        excess = smooth_positive(v - cap, _PLASTIC_SMOOTHING)
+        return v - excess, _PLASTIC_GAP_SCALE * self.sc.h_ref * excess
+
+    def shape(self, v):
+        """The film without H0 and the rigid gap: deformation, offset (roughness) and plastic gap
+        for the pressure unknowns v."""
+        p, delta = self.plastic(v)
+        h = self.deformation(p + self.asperity) + self.offset
+        return h if delta is None else h + delta
 
     def deformation(self, p):
         if self.model.use_fft(self.n):
@@ -757,8 +798,9 @@ class _Level(eqx.Module):
         return (self.kernel_rows @ p)[2 : self.n + 2]
 
     def film(self, u):
-        p, h0 = u[: self.n], u[self.n]
-        return h0 + 0.5 * self.x**2 + self.offset + self.deformation(p + self.asperity)
+        p, delta = self.plastic(u[: self.n])
+        h = u[self.n] + 0.5 * self.x**2 + self.offset + self.deformation(p + self.asperity)
+        return h if delta is None else h + delta
 
     def local(self, p, h, s):
         """Node-wise FB residual as a function of P and H (banded dependence, bandwidth −2…+1)."""
@@ -803,14 +845,32 @@ class _Level(eqx.Module):
         return (self.spacing * jnp.sum(p + self.asperity) - 0.5 * jnp.pi) / (0.5 * jnp.pi)
 
     def residual(self, u, s=1.0):
-        p = u[: self.n]
+        p = self.plastic(u[: self.n])[0]
         return jnp.concatenate([self.local(p, self.film(u), s), self.load_row(p)[None]])
+
+    def bands(self, u, s):
+        """The band derivatives of ``local`` at u (``_bands``) with respect to the unknowns v and
+        to the elastic film (the film without the plastic gap), and dP/dv (None without a
+        pressure limit): J = band(dv) + dh D diag(dP/dv)."""
+        v = u[: self.n]
+        if self.model.hardness is None:
+            _, dvs, dhs = _bands(lambda pp, hh: self.local(pp, hh, s), v, self.film(u))
+            return dvs, dhs, None
+        p, delta = self.plastic(v)
+        elastic = self.film(u) - delta
+
+        def local_v(vv, hh):
+            pp, dd = self.plastic(vv)
+            return self.local(pp, hh + dd, s)
+
+        _, dvs, dhs = _bands(local_v, v, elastic)
+        slope = jax.jvp(lambda vv: self.plastic(vv)[0], (v,), (jnp.ones_like(v),))[1]
+        return dvs, dhs, slope
 
     def jacobian(self, u, s=1.0):
         n = self.n
         p = u[:n]
-        h = self.film(u)
-        _, dps, dhs = _bands(lambda pp, hh: self.local(pp, hh, s), p, h)
+        dps, dhs, slope = self.bands(u, s)
         rows = jnp.arange(n)
         offsets = _BAND
         # J[i, j] = Σ_k dP_k[i] [j = i + k] + Σ_k dH_k[i] D[i + k, j]: the shifted influence rows
@@ -827,13 +887,15 @@ class _Level(eqx.Module):
         dense = jnp.zeros((n, n), dtype=p.dtype)
         for k, dp, dh in zip(offsets, dps, dhs, strict=True):
             shifted = kernel_rows[k + 2 : k + 2 + n]
+            if slope is not None:  # the deformation responds to P = P(v): its columns × dP/dv
+                shifted = shifted * slope[None, :]
             dense = dense + dh[:, None] * shifted + jnp.where(m == -k, dp[:, None], 0.0)
         h0_col = sum(dhs)
         top = jnp.concatenate([dense, h0_col[:, None]], axis=1)
-        bottom = jnp.concatenate(
-            [jnp.full((1, n), self.spacing / (0.5 * jnp.pi), dtype=p.dtype), jnp.zeros((1, 1))],
-            axis=1,
-        )
+        load = jnp.full((n,), self.spacing / (0.5 * jnp.pi), dtype=p.dtype)
+        if slope is not None:
+            load = load * slope
+        bottom = jnp.concatenate([load[None, :], jnp.zeros((1, 1))], axis=1)
         return jnp.concatenate([top, bottom], axis=0)
 
 
@@ -994,7 +1056,7 @@ def _block_preconditioner(level: _Level, u, s):
     truncated deformation derivative loses its diagonal.)"""
     n, size = level.n, _KRYLOV_BLOCK
     count = -(-n // size)
-    _, dps, dhs = _bands(lambda pp, hh: level.local(pp, hh, s), u[: level.n], level.film(u))
+    dps, dhs, slope = level.bands(u, s)
 
     def blocked(v, fill=0.0):
         return jnp.concatenate([v, jnp.full((count * size - n,), fill, v.dtype)]).reshape(
@@ -1005,8 +1067,11 @@ def _block_preconditioner(level: _Level, u, s):
     offset = a[:, None] - a[None, :]  # i − j within a block
     centre = _KRYLOV_BLOCK + 2
     blocks = jnp.zeros((count, size, size), u.dtype)
-    for k, dp, dh in zip(_BAND, dps, dhs, strict=True):
-        blocks = blocks + blocked(dh)[:, :, None] * level.kernel_near[offset + k + centre]
+    near = [level.kernel_near[offset + k + centre] for k in _BAND]
+    if slope is not None:  # columns × dP/dv (``_Level.bands``)
+        near = [d[None] * blocked(slope)[:, None, :] for d in near]
+    for k, dp, dh, d in zip(_BAND, dps, dhs, near, strict=True):
+        blocks = blocks + blocked(dh)[:, :, None] * d
         blocks = blocks + blocked(dp)[:, :, None] * (offset == -k)
     # the padding past the last node: identity rows
     blocks = blocks + blocked(jnp.zeros((n,), u.dtype), 1.0)[:, :, None] * (offset == 0)
@@ -1168,7 +1233,7 @@ def _transfer(coarse: _Level, fine: _Level, u, cubic=False):
 def _offset_for_central_film(level: _Level, p, hc, window: bool = False):
     """H0 that puts the central film H(0) at ``hc`` for pressure P on ``level``; with ``window``,
     the mean film over the central window (``_central_window``) instead."""
-    shape = level.deformation(p + level.asperity) + level.offset
+    shape = level.shape(p)
     if window:
         w = _central_window(level.x)
         return hc - jnp.sum(w * (shape + 0.5 * level.x**2)) / jnp.sum(w)
@@ -1387,8 +1452,10 @@ def _distributive_relaxation(level: _Level, u, sweeps: int):
         r, diag = level.reynolds(p, h, 1.0)
         return r / (1.0 + diag)
 
+    cap = None if level.model.hardness is None else level.model.hardness / level.sc.ph
+
     def sweep(u):
-        p = u[:n]
+        p, delta = level.plastic(u[:n])
         r, dps, dhs = _bands(scaled_reynolds, p, level.film(u))
         dp, dh = dict(zip(_BAND, dps, strict=True)), dict(zip(_BAND, dhs, strict=True))
         film_self = sum(dh[k] * infl[k] for k in _BAND)
@@ -1402,7 +1469,11 @@ def _distributive_relaxation(level: _Level, u, sweeps: int):
         shared = jnp.where(dist, delta, 0.0)
         change = delta - 0.5 * (jnp.roll(shared, 1) + jnp.roll(shared, -1))
         p_new = jnp.maximum(p + change, 0.0).at[0].set(0.0).at[-1].set(0.0)
+        if cap is not None:
+            p_new = jnp.minimum(p_new, cap)
         h0 = u[n] + _RELAX_LOAD_GAIN * level.load_row(p_new) * level.sc.h_ref
+        if cap is not None:  # back to the unknowns v: the plastic gap kept where P stays at P_cap
+            p_new = p_new + jnp.where(p_new >= cap, delta / level.sc.h_ref, 0.0)
         return jnp.concatenate([p_new, h0[None]])
 
     end = jax.lax.fori_loop(0, sweeps, lambda _, v: sweep(v), u)
@@ -1843,7 +1914,8 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     n = lev.n
     r = c.reduced_radius
     h_scale = sc.b**2 / r
-    p_dim = sc.ph * u[:n]
+    p_nd, delta = lev.plastic(u[:n])
+    p_dim = sc.ph * p_nd
     big_h = lev.film(u)
     h = big_h * h_scale
     x = lev.x * sc.b
@@ -1946,6 +2018,7 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
         power_loss_asperity=p_loss_asp,
         contact_fraction=fraction,
         contact_load=jnp.sum(weights * (contact * p_dim + p_asp)),
+        plastic_gap=jnp.zeros_like(h) if delta is None else delta * h_scale,
         load_error=load_err,
         hertz_half_width=sc.b,
         hertz_pressure=sc.ph,
