@@ -773,10 +773,11 @@ class _Level(eqx.Module):
         """(P, δ) of the pressure unknowns v: the pressure and the dimensionless plastic gap.
 
         Without a pressure limit (``EHLModel.hardness`` None) P = v and δ is None. With one,
-        P = min(v, P_cap) and δ = c H_ref max(v − P_cap, 0) (c = ``_PLASTIC_GAP_SCALE``,
-        both smoothed over ``_PLASTIC_SMOOTHING``): where the surface yields, its pressure stays at the limit and the
-        gap opens by δ ≥ 0 (the asperity flattened), complementary to P_cap − P ≥ 0. The Reynolds
-        equation holds at every node, plastic ones included, so the flow is conserved there."""
+        P = min(v, P_cap) and δ = c H_ref max(v − P_cap, 0) (c = ``_PLASTIC_GAP_SCALE``, both
+        smoothed over ``_PLASTIC_SMOOTHING``): where the surface yields, its pressure stays at the
+        limit and the gap opens by δ ≥ 0 (the asperity flattened), complementary to P_cap − P ≥ 0.
+        The Reynolds equation holds at every node, plastic ones included, so the flow is conserved
+        there."""
         if self.model.hardness is None:
             return v, None
         cap = self.model.hardness / self.sc.ph
@@ -1455,7 +1456,8 @@ def _distributive_relaxation(level: _Level, u, sweeps: int):
     cap = None if level.model.hardness is None else level.model.hardness / level.sc.ph
 
     def sweep(u):
-        p, delta = level.plastic(u[:n])
+        p = level.plastic(u[:n])[0]
+        excess = u[:n] - p  # v − P: the plastic gap in the unknowns' units
         r, dps, dhs = _bands(scaled_reynolds, p, level.film(u))
         dp, dh = dict(zip(_BAND, dps, strict=True)), dict(zip(_BAND, dhs, strict=True))
         film_self = sum(dh[k] * infl[k] for k in _BAND)
@@ -1473,7 +1475,7 @@ def _distributive_relaxation(level: _Level, u, sweeps: int):
             p_new = jnp.minimum(p_new, cap)
         h0 = u[n] + _RELAX_LOAD_GAIN * level.load_row(p_new) * level.sc.h_ref
         if cap is not None:  # back to the unknowns v: the plastic gap kept where P stays at P_cap
-            p_new = p_new + jnp.where(p_new >= cap, delta / level.sc.h_ref, 0.0)
+            p_new = p_new + jnp.where(p_new >= cap, excess, 0.0)
         return jnp.concatenate([p_new, h0[None]])
 
     end = jax.lax.fori_loop(0, sweeps, lambda _, v: sweep(v), u)
@@ -1494,15 +1496,20 @@ def _warm_args(sol: EHLSolution, window: bool = False, moved: bool = False):
         hc = jnp.sum(w * sol.h) / jnp.sum(w)
     ratio = hc / jnp.where(sol.moes_film > 0.0, sol.moes_film, jnp.inf)
     ratio = jnp.where(jnp.isfinite(ratio) & (ratio > 0.0), jnp.clip(ratio, 0.05, 20.0), 1.0)
-    p = jnp.where(jnp.isfinite(sol.fluid_pressure), sol.fluid_pressure, 0.0)
+    p = jnp.where(jnp.isfinite(sol.fluid_pressure), sol.fluid_pressure, 0.0) / ph
+    # a yielded film (``EHLModel.hardness``): the unknowns v = P + δ/(c H_ref) above the limit, so
+    # that the start keeps its plastic gap (zero for elastic films)
+    film_scale = _PLASTIC_GAP_SCALE * jnp.where(sol.moes_film > 0.0, sol.moes_film, jnp.inf)
+    gap = jnp.where(jnp.isfinite(sol.plastic_gap), sol.plastic_gap, 0.0)
+    p = p + gap / film_scale
     if not window:
-        return sol.x / b, p / ph, ratio
+        return sol.x / b, p, ratio
     # and (H0 − H_c)/E' in Hertz-scaled film units, b²/R = 4 b ph/E' (Hertz line contact): the
     # next contact multiplies by its E'. NaN (unused) for a failed or placeholder solution
     excess = (sol.h0 - hc) / (4.0 * b * ph)
     good = sol.converged & jnp.isfinite(excess)
     flag = jnp.asarray(1.0 if moved else 0.0, dtype=ratio.dtype)
-    return sol.x / b, p / ph, jnp.stack([ratio, jnp.where(good, excess, jnp.nan), flag])
+    return sol.x / b, p, jnp.stack([ratio, jnp.where(good, excess, jnp.nan), flag])
 
 
 @functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2))
