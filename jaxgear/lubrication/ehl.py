@@ -857,8 +857,7 @@ class _Level(eqx.Module):
         if self.model.hardness is None:
             _, dvs, dhs = _bands(lambda pp, hh: self.local(pp, hh, s), v, self.film(u))
             return dvs, dhs, None
-        p, delta = self.plastic(v)
-        elastic = self.film(u) - delta
+        elastic = self.film(u) - self.plastic(v)[1]
 
         def local_v(vv, hh):
             pp, dd = self.plastic(vv)
