@@ -295,9 +295,11 @@ class EHLModel(eqx.Module):
             keeps the Reynolds equation, so the flow, at every node: P and δ complementary,
             through one unknown per node (``_Level.plastic``). It bounds the asperity pressure of
             deterministic roughness, where an elastic half-space puts none (13.5 GPa on the
-            ground surfaces at 500 rpm on 1025 nodes). A passage does not carry δ from step to
-            step: each step's surfaces start elastic (no run-in memory). The statistical
-            asperity pressure (``mixed="statistical"``) is outside it.
+            ground surfaces at 500 rpm on 1025 nodes). A passage
+            (``passage.solve_ehl_passage``) runs the surfaces in: what a step flattens stays in
+            both profiles (half each) and travels with each surface, so a later step's δ is only
+            what more yields. The statistical asperity pressure (``mixed="statistical"``) is
+            outside it.
     """
 
     n_nodes: int = eqx.field(static=True, default=257)
@@ -1481,12 +1483,14 @@ def _distributive_relaxation(level: _Level, u, sweeps: int):
     return jnp.where(jnp.all(jnp.isfinite(end)), end, u)
 
 
-def _warm_args(sol: EHLSolution, window: bool = False, moved: bool = False):
+def _warm_args(sol: EHLSolution, window: bool = False, moved: bool = False, plastic: bool = True):
     """(X, P, H_c/H_Moes) of a solution: what ``_warm_start`` reads. Guarded so that a failed or
     placeholder solution gives a harmless start (the cold fallback follows if it does not
     converge). ``window`` (deterministic roughness): H_c is the mean film over the central window,
     and the third item is [H_c/H_Moes, (H0 − H_c)/E', moved], ``moved`` telling that the roughness
-    has moved since ``sol`` (a transient step: the start is filtered and relaxed)."""
+    has moved since ``sol`` (a transient step: the start is filtered and relaxed). ``plastic``:
+    the start carries ``sol``'s plastic gap (False where the surfaces carry it instead: a run-in
+    passage)."""
     b = jnp.where(sol.hertz_half_width > 0.0, sol.hertz_half_width, 1.0)
     ph = jnp.where(sol.hertz_pressure > 0.0, sol.hertz_pressure, 1.0)
     hc = sol.h_central
@@ -1499,8 +1503,9 @@ def _warm_args(sol: EHLSolution, window: bool = False, moved: bool = False):
     # a yielded film (``EHLModel.hardness``): the unknowns v = P + δ/(c H_ref) above the limit, so
     # that the start keeps its plastic gap (zero for elastic films)
     film_scale = _PLASTIC_GAP_SCALE * jnp.where(sol.moes_film > 0.0, sol.moes_film, jnp.inf)
-    gap = jnp.where(jnp.isfinite(sol.plastic_gap), sol.plastic_gap, 0.0)
-    p = p + gap / film_scale
+    if plastic:
+        gap = jnp.where(jnp.isfinite(sol.plastic_gap), sol.plastic_gap, 0.0)
+        p = p + gap / film_scale
     if not window:
         return sol.x / b, p, ratio
     # and (H0 − H_c)/E' in Hertz-scaled film units, b²/R = 4 b ph/E' (Hertz line contact): the

@@ -177,7 +177,7 @@ def _squeeze_history(model, rho_h_prev, inv_dt, older, usable, dt, read_older):
     ∂(ρh)/∂t ≈ [a0 ρh − (1 + ω) ρhⁿ + ω²/(1 + ω) ρhⁿ⁻¹]/Δt, a0 = (1 + 2ω)/(1 + ω); the term is
     linear in ρh, so it is one backward-Euler-shaped term with 1/Δt × a0 and the reference
     [(1 + ω) ρhⁿ − ω²/(1 + ω) ρhⁿ⁻¹]/a0 (the residual is unchanged). ``older`` carries step
-    n − 1 (its ``[-1]`` Δt_prev), ``read_older(older)`` its ρh where this step reads it; where
+    n − 1 (its ``[9]`` Δt_prev), ``read_older(older)`` its ρh where this step reads it; where
     it is not ``usable`` (the first transient step, or after a failed step) the step is backward
     Euler."""
     if model.time_scheme != "bdf2":
@@ -190,7 +190,7 @@ def _bdf2(older, usable, dt):
     """BDF2 with variable steps as a backward-Euler-shaped term: (a0, blend), with
     ∂y/∂t ≈ a0 [y − blend(yⁿ, yⁿ⁻¹)]/Δt (``_squeeze_history``); backward Euler where not
     ``usable``."""
-    w = dt / jnp.maximum(older[-1], 1e-300)
+    w = dt / jnp.maximum(older[9], 1e-300)  # Δt_prev
     a0 = jnp.where(usable, (1.0 + 2.0 * w) / (1.0 + w), 1.0)
 
     def blend(y_prev, y_old):
@@ -200,8 +200,16 @@ def _bdf2(older, usable, dt):
     return a0, blend
 
 
+def _runs_in(model: EHLModel, mixed: str) -> bool:
+    """Whether a passage carries its surfaces' plastic flattening from step to step
+    (``_run_in``): deterministic roughness under a pressure limit."""
+    return model.hardness is not None and mixed == "deterministic"
+
+
 def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, first):
-    prev, temp1, temp2, d, t_prev, u_prev, older, older_ok = carry
+    prev, temp1, temp2, d, t_prev, u_prev, older, older_ok, worn = carry
+    # under a pressure limit the surfaces carried from the previous steps (run in), else the given
+    surfaces = surfaces if worn is None else worn
     bdf2 = model.time_scheme == "bdf2"
     dt = jnp.maximum(t - t_prev, 1e-300)
     u_now = jnp.stack([contact.u1, contact.u2])
@@ -236,12 +244,13 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         inv_dt = jnp.where(prev_ok, 1.0 / dt, 0.0)
 
         def read_older(older):
-            # step n − 1, carried along the characteristics over that step and this one
+            # step n − 1, carried along the characteristics over that step and this one (its
+            # roughness as the surfaces stood after it: the film it solved, flattening included)
             x_old, rho_h_old, rho_old, d_old, shift_old = older[:5]
             return _film_at_feet(
                 model,
                 mixed,
-                surfaces,
+                surfaces if older[10] is None else older[10],
                 x,
                 shift + shift_old,
                 x_old,
@@ -314,7 +323,10 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
             model, False, mixed, inp, x[:2], x[:2], jnp.zeros(()), solids, transient
         )
     else:
-        args = _warm_args(prev, mixed == "deterministic", moved=True)
+        # run-in surfaces carry the previous plastic gap in their heights, so the start does not
+        args = _warm_args(
+            prev, mixed == "deterministic", moved=True, plastic=not _runs_in(model, mixed)
+        )
         sol, temps = _solve_impl(model, True, mixed, inp, *args, solids, transient)
     # step n − 1 as BDF2's older level for the next step: usable if it was a solution (not the
     # first step's placeholder) that converged
@@ -329,6 +341,7 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         temp2,
         solid_shift,
         dt,
+        worn,
     )
     if model.thermal:
         temp1 = thermal_mod.transient_update(
@@ -338,7 +351,32 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
             frees[1][0], frees[1][1], temps.flux2, depth
         ).temperature
     older_ok = jnp.asarray(False) if first else prev_ok
-    return (sol, temp1, temp2, d, t, u_now, older, older_ok), sol
+    if worn is not None:
+        worn = _run_in(surfaces, sol, d)
+    return (sol, temp1, temp2, d, t, u_now, older, older_ok, worn), sol
+
+
+def _run_in(surfaces: Surfaces, sol: EHLSolution, d) -> Surfaces:
+    """The surfaces after a step whose contact yielded (``EHLModel.hardness``): each profile
+    lowered by half the step's plastic gap δ (both surfaces equally hard) at the material points
+    that stood at the film's nodes, its surface displaced by d_j. The flattening is plastic, so
+    it stays, and it travels with the surface that yielded; the next step's δ is only what more
+    yields. A failed step flattens nothing.
+
+    Why: without it each step starts from the original roughness, and an asperity that yielded
+    springs back one step later, an elastic-perfectly plastic solid recovering what it cannot."""
+    gap = jnp.where(sol.converged & jnp.all(jnp.isfinite(sol.plastic_gap)), sol.plastic_gap, 0.0)
+    scale = jnp.where(surfaces.scale > 0.0, surfaces.scale, 1.0)
+    profiles = []
+    for j, z in enumerate((surfaces.profile1, surfaces.profile2)):
+        n = z.shape[0]
+        # contact positions x = ξ + x_j0 + d_j of the profile's samples, on the period that starts
+        # at the film's first node (``Surfaces.displaced_height``'s map, inverted)
+        x = jnp.arange(n) * surfaces.dx + surfaces.offset[j] + d[j]
+        x = sol.x[0] + jnp.mod(x - sol.x[0], n * surfaces.dx)
+        delta = jnp.interp(x, sol.x, gap, left=0.0, right=0.0)
+        profiles.append(z - 0.5 * delta / scale)
+    return eqx.tree_at(lambda s: (s.profile1, s.profile2), surfaces, tuple(profiles))
 
 
 @eqx.filter_jit
@@ -377,6 +415,7 @@ def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, 
         zeros_t,
         jnp.zeros_like(u0),
         dt0,
+        surfaces if _runs_in(model, mixed) else None,
     )
     carry = (
         placeholder,
@@ -387,6 +426,7 @@ def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, 
         u0,
         older,
         jnp.asarray(False),
+        surfaces if _runs_in(model, mixed) else None,
     )
     carry, sol0 = _step(
         model, mixed, lubricant, surfaces, solids, depth, carry, first_contact, times[0], True
@@ -397,8 +437,9 @@ def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, 
         contact, t = xs
         return _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, False)
 
-    _, sols = jax.lax.scan(body, carry, (rest, times[1:]))
-    return jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), sol0, sols)
+    carry, sols = jax.lax.scan(body, carry, (rest, times[1:]))
+    sols = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), sol0, sols)
+    return sols, carry[8]
 
 
 def solve_ehl_passage(
@@ -410,7 +451,8 @@ def solve_ehl_passage(
     times,
     displacement=(0.0, 0.0),
     solids=None,
-) -> EHLSolution:
+    return_surfaces: bool = False,
+) -> EHLSolution | tuple[EHLSolution, Surfaces | None]:
     """March one contact through ``K`` states (transient EHL, ``lax.scan``).
 
     Args:
@@ -424,9 +466,16 @@ def solve_ehl_passage(
             from the ones before.
         displacement: (d1, d2) of the surfaces at ``times[0]``, m.
         solids: (Material, Material) of gears 1 and 2 (default steel).
+        return_surfaces: also return the surfaces as the passage left them.
+
+    Under a pressure limit (``EHLModel.hardness``) with deterministic roughness the surfaces run
+    in: after each step both profiles are lowered by half its plastic gap where their material
+    stood, and the flattening travels with each surface into the later steps (``_run_in``).
 
     Returns:
-        EHLSolution with a leading axis K (per-step ``converged``; the grid of each step is in x).
+        EHLSolution with a leading axis K (per-step ``converged``; the grid of each step is in x);
+        with ``return_surfaces``, (that, the run-in Surfaces), the second None where nothing runs
+        in (no pressure limit, or no deterministic roughness: ``surfaces`` unchanged then).
     """
     model = EHLModel() if model is None else model
     if not isinstance(model, EHLModel):
@@ -452,7 +501,7 @@ def solve_ehl_passage(
     # (``ehl._pseudo_march``): measured on one engagement (257 nodes, 3500 rpm, 2026-11-27), it
     # did not rescue the one step that failed, and it made the engagement cost 49 s against 33 s
     model = dataclasses.replace(model, pseudo_transient_steps=0)
-    return _passage(
+    sols, worn = _passage(
         model,
         mixed,
         contacts,
@@ -462,3 +511,4 @@ def solve_ehl_passage(
         jnp.asarray(displacement, dtype=float),
         solids,
     )
+    return (sols, worn) if return_surfaces else sols
