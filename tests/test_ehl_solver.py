@@ -38,7 +38,7 @@ def test_pitch_contact_converges_balances_load_and_cavitates_without_negative_pr
     # cavitation by complementarity: the smoothed FB keeps P·(−R) = δ²/2 > 0, so pressures stay
     # non-negative up to the smoothing (δ ph).
     ph = float(c.hertz_pressure)
-    assert p.min() > -STANDARD.fb_smoothing * ph
+    assert p.min() > -STANDARD.smoothing(rough=False) * ph
     # the outlet holds a cavitated zone (p ≈ 0 downstream of the contact) and the minimum film lies
     # at the outlet constriction, below the central film
     b = float(c.hertz_half_width)

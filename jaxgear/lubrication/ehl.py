@@ -68,6 +68,10 @@ LINEAR_SOLVERS = ("dense", "krylov")
 TIME_SCHEMES = ("backward_euler", "bdf2")
 TRANSPORT_SCHEMES = ("eulerian", "characteristic")
 
+# Fischer-Burmeister δ (in ph) by default (``EHLModel.fb_smoothing``): smooth and statistical
+# films, deterministic rough films
+_FB_SMOOTHING = 1e-8
+_FB_SMOOTHING_ROUGH = 1e-6
 _LOG_VISCOSITY_CAP = 500.0  # cap on ln(η/η0): keeps iterates finite (η/η0 ≤ e^500)
 _FLOOR_FRACTION = 1e-3  # smooth film floor inside ε, relative to the reference film
 # smoothing of the pressure limit's kink P = min(v, P_cap) (``EHLModel.hardness``), in ph
@@ -150,7 +154,17 @@ class EHLModel(eqx.Module):
             τm h/us its secant: "eyring_split" uses the secant (the stress τm) in the sliding
             friction and heat, and η* in the flow coefficient, the Poiseuille heat and the damping
             (the response to a small pressure flow or sliding-speed change on top of the shear).
-        fb_smoothing: δ of the Fischer-Burmeister function.
+        fb_smoothing: δ of the Fischer-Burmeister function (in ph); None (default): 1e-8, and
+            1e-6 for deterministic rough films (``smoothing``). δ relaxes the complementarity to
+            P·g = δ²/2, so where the exact pressure is below δ ph it is held near δ ph instead,
+            above all at the first node past the inlet's P = 0; under the thick inlet film that
+            jump's Poiseuille heat grows as 1/Δx. Measured (1000 rpm, SRR 0.3, smooth, 257 / 513
+            / 1025 / 2049 nodes): rolling loss 158.6 / 191.6 / 308.4 / 753.8 W/m at δ = 1e-6
+            (every film's default until 2026-11-29), 146.4 / 148.2 / 148.6 / 148.8 W/m at 1e-8
+            and 1e-10; the sliding loss and the Newton iterations the same. Deterministic rough
+            films keep 1e-6: their relaxed warm starts were tuned there, and at 1e-8 a step of
+            the ground film at speed E falls back to the cold solve (99 Newton iterations against
+            8; tests/test_mixed_thermal.py), while their rolling heat is the asperity edges'.
         tolerance: ‖F‖∞ below which a Newton solve has converged.
         max_iterations: Newton iterations per grid level (and per continuation step).
         coarsest_nodes: smallest grid of the sequence.
@@ -309,7 +323,7 @@ class EHLModel(eqx.Module):
     viscosity: str = eqx.field(static=True, default="roelands")
     compressibility: str = eqx.field(static=True, default="dowson_higginson")
     shear: str = eqx.field(static=True, default="eyring_paper")
-    fb_smoothing: float = eqx.field(static=True, default=1e-6)
+    fb_smoothing: float | None = eqx.field(static=True, default=None)
     tolerance: float = eqx.field(static=True, default=1e-9)
     max_iterations: int = eqx.field(static=True, default=30)
     coarsest_nodes: int = eqx.field(static=True, default=65)
@@ -369,7 +383,8 @@ class EHLModel(eqx.Module):
             )
         if self.hardness is not None:
             check_range("EHLModel.hardness", self.hardness, 1e8, 1e11)
-        check_range("EHLModel.fb_smoothing", self.fb_smoothing, 0.0, 1e-2, low_inclusive=False)
+        if self.fb_smoothing is not None:
+            check_range("EHLModel.fb_smoothing", self.fb_smoothing, 0.0, 1e-2, low_inclusive=False)
         check_range("EHLModel.tolerance", self.tolerance, 0.0, 1e-2, low_inclusive=False)
         check_range("EHLModel.thermal_rtol", self.thermal_rtol, 0.0, 0.5, low_inclusive=False)
         check_range("EHLModel.thermal_atol", self.thermal_atol, 0.0, 10.0, low_inclusive=False)
@@ -400,6 +415,13 @@ class EHLModel(eqx.Module):
                 continue
             if not isinstance(v, int) or v < 1:
                 raise ValueError(f"EHLModel.{name} = {v!r} is out of range; valid range: [1, inf)")
+
+    def smoothing(self, rough: bool) -> float:
+        """The Fischer-Burmeister δ (in ph) of a solve: ``fb_smoothing``, or by default 1e-8, and
+        1e-6 for a deterministic rough film (``rough``); see ``fb_smoothing``."""
+        if self.fb_smoothing is not None:
+            return self.fb_smoothing
+        return _FB_SMOOTHING_ROUGH if rough else _FB_SMOOTHING
 
     @property
     def grid_sizes(self) -> tuple[int, ...]:
@@ -808,7 +830,7 @@ class _Level(eqx.Module):
     def local(self, p, h, s):
         """Node-wise FB residual as a function of P and H (banded dependence, bandwidth −2…+1)."""
         r, diag = self.reynolds(p, h, s)
-        f = fischer_burmeister(p, -r / (1.0 + diag), self.model.fb_smoothing)
+        f = fischer_burmeister(p, -r / (1.0 + diag), self.model.smoothing(self.inp.rough))
         return f.at[0].set(p[0]).at[-1].set(p[-1])
 
     def reynolds(self, p, h, s):
@@ -1901,6 +1923,9 @@ def _solve_core_jvp(model, warm, mixed, primals, tangents):
     inp, init_x, init_p, init_h0 = primals
     d_inp = tangents[0]
     u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0)
+    if mixed == "deterministic":  # the system the solve solved (``EHLModel.smoothing``)
+        inp = dataclasses.replace(inp, rough=True)
+        d_inp = dataclasses.replace(d_inp, rough=True)
 
     def fine_residual(theta):
         return _fine_level(model, theta)[1].residual(u, 1.0)

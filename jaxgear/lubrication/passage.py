@@ -177,7 +177,7 @@ def _squeeze_history(model, rho_h_prev, inv_dt, older, usable, dt, read_older):
     ∂(ρh)/∂t ≈ [a0 ρh − (1 + ω) ρhⁿ + ω²/(1 + ω) ρhⁿ⁻¹]/Δt, a0 = (1 + 2ω)/(1 + ω); the term is
     linear in ρh, so it is one backward-Euler-shaped term with 1/Δt × a0 and the reference
     [(1 + ω) ρhⁿ − ω²/(1 + ω) ρhⁿ⁻¹]/a0 (the residual is unchanged). ``older`` carries step
-    n − 1 (its ``[9]`` Δt_prev), ``read_older(older)`` its ρh where this step reads it; where
+    n − 1 (its ``[-1]`` Δt_prev), ``read_older(older)`` its ρh where this step reads it; where
     it is not ``usable`` (the first transient step, or after a failed step) the step is backward
     Euler."""
     if model.time_scheme != "bdf2":
@@ -190,7 +190,7 @@ def _bdf2(older, usable, dt):
     """BDF2 with variable steps as a backward-Euler-shaped term: (a0, blend), with
     ∂y/∂t ≈ a0 [y − blend(yⁿ, yⁿ⁻¹)]/Δt (``_squeeze_history``); backward Euler where not
     ``usable``."""
-    w = dt / jnp.maximum(older[9], 1e-300)  # Δt_prev
+    w = dt / jnp.maximum(older[-1], 1e-300)
     a0 = jnp.where(usable, (1.0 + 2.0 * w) / (1.0 + w), 1.0)
 
     def blend(y_prev, y_old):
@@ -250,7 +250,7 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
             return _film_at_feet(
                 model,
                 mixed,
-                surfaces if older[10] is None else older[10],
+                surfaces if older[9] is None else older[9],
                 x,
                 shift + shift_old,
                 x_old,
@@ -340,8 +340,8 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         temp1,
         temp2,
         solid_shift,
-        dt,
         worn,
+        dt,
     )
     if model.thermal:
         temp1 = thermal_mod.transient_update(
@@ -414,8 +414,8 @@ def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, 
         zeros_t,
         zeros_t,
         jnp.zeros_like(u0),
-        dt0,
         surfaces if _runs_in(model, mixed) else None,
+        dt0,
     )
     carry = (
         placeholder,
