@@ -273,6 +273,11 @@ class SimulationResult(eqx.Module):
         failed_contacts: loaded contacts of the cycle whose EHL solve failed (status 3); their
             outputs are carried over from the nearest good contact of the engagement, never used as
             they came out.
+        back_contact_share: share of the mesh cycle with back-flank contact (the mesh deflection
+            past the backlash, negative tooth forces; on status 6 over every recorded cycle of the
+            attractor). Those contacts' friction and loss are not modelled: Φ̄ counts the drive
+            flanks only, so where this is not 0 (rattling teeth that strike back, e.g. 3750-3900 rpm
+            of the calibrated pair) Φ̄ is short by the back flanks' loss. 0 when quasi-static.
     """
 
     power_loss: Float[Array, ""]
@@ -296,6 +301,7 @@ class SimulationResult(eqx.Module):
     fixed_point_residual: Float[Array, ""]
     fixed_point_iterations: Int[Array, ""]
     failed_contacts: Int[Array, ""]
+    back_contact_share: Float[Array, ""]
 
 
 def kinematic_velocities(pair: GearPair, mesh: MeshCycle, omega1):
@@ -317,7 +323,15 @@ def _dynamics_options(fidelity: Fidelity) -> DynamicsOptions:
     )
 
 
-def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, iterations):
+def _back_contact_share(load):
+    """Share of the positions of one cycle's tooth forces ``load`` [..., M, 2] whose mesh force
+    (their sum) is negative: back-flank contact."""
+    return jnp.mean((jnp.sum(load, axis=-1) < 0.0).astype(load.dtype))
+
+
+def _assemble(
+    pair, op, mesh, forces, load, velocity, dte, status, residual, iterations, back_contact=None
+):
     power_pair = forces.power_sliding + forces.power_rolling
     sliding = cycle_mean(total_per_position(forces.power_sliding))
     rolling = cycle_mean(total_per_position(forces.power_rolling))
@@ -347,6 +361,9 @@ def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, ite
         fixed_point_residual=jnp.asarray(residual, dtype=loss.dtype),
         fixed_point_iterations=jnp.asarray(iterations, dtype=jnp.int32),
         failed_contacts=jnp.asarray(forces.failed, dtype=jnp.int32),
+        back_contact_share=(
+            _back_contact_share(load) if back_contact is None else jnp.asarray(back_contact)
+        ).astype(loss.dtype),
     )
 
 
@@ -547,13 +564,14 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     )
     load, velocity, dte = state["load"], state["velocity"], state["dte"]
     attractor, on_attractor = jnp.zeros(13, dtype=zeros.dtype), jnp.zeros((), dtype=zeros.dtype)
+    back = _back_contact_share(load)
     if fidelity.attractor_periods > 0:
         warm_attractor = (warm.attractor, warm.on_attractor)
-        forces, load, velocity, dte, status, (attractor, on_attractor) = _attractor_means(
+        forces, load, velocity, dte, status, (attractor, on_attractor), back = _attractor_means(
             pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
         )
     result = _assemble(
-        pair, op, mesh, forces, load, velocity, dte, status, residual, sol.stats["num_steps"]
+        pair, op, mesh, forces, load, velocity, dte, status, residual, sol.stats["num_steps"], back
     )
     return result, WarmStart(
         interface=state["interface"],
@@ -578,7 +596,8 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     mixed EHL contact scaled to the rung's level on the orbit (below), not by new EHL solves.
     Returned per position: the means over those cycles of the contact outputs (so Φ̄ is the
     record's mean loss), tooth forces and velocities, and the DTE's mean over the whole record (its mesh harmonics are the record's). Status 6 (STATUS_ATTRACTOR), or the status kept
-    where the record is not finite. No derivative passes through the attractor (its means are not
+    where the record is not finite. Last, the share of the whole record's positions in back-flank
+    contact (``SimulationResult.back_contact_share``; the orbit's where the record is not finite). No derivative passes through the attractor (its means are not
     smooth functions of the design).
 
     ``warm``: (state [13], flag) of the previous point's attractor in a continuation sweep; where
@@ -695,12 +714,16 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         end = jnp.concatenate([rec.final_state, rec.load_torque_correction[None]])
         handover = (jnp.where(ok, end, 0.0), jnp.where(ok, 1.0, 0.0).astype(end.dtype))
         status = jnp.where(ok, STATUS_ATTRACTOR, status).astype(status.dtype)
-        return (*picked, status, handover)
+        back = jnp.where(
+            ok, jnp.mean((rec.mesh_force < 0.0).astype(load.dtype)), _back_contact_share(load)
+        )
+        return (*picked, status, handover, back)
 
     def keep(operand):
         *_, st, status, warm = operand
         off = (jnp.zeros_like(warm[0]), jnp.zeros_like(warm[1]))
-        return st["forces"], st["load"], st["velocity"], st["dte"], status, off
+        back = _back_contact_share(st["load"])
+        return st["forces"], st["load"], st["velocity"], st["dte"], status, off, back
 
     unstable = (state["dynamics_ok"] < 0.5) & jnp.all(jnp.isfinite(state["guess"]))
     # The branch is costly to compile (the dynamics in time): traced once, without the all-members

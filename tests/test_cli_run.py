@@ -31,6 +31,10 @@ def test_run_writes_results_and_resumes(tmp_path, capsys):
     assert 99.6 < head["mean_efficiency_percent"] < 99.95
     rows = (out / "sweep.csv").read_text().splitlines()
     assert rows[0].startswith("speed_rpm,power_loss_W") and len(rows) == 3
+    # stable orbits at these speeds: no back-flank strikes, whose loss Φ̄ would leave out
+    header = rows[0].split(",")
+    assert [r.split(",")[header.index("back_contact_share")] for r in rows[1:]] == ["0", "0"]
+    assert head["points_with_back_contact"] == 0 and summary["back_contact"] == []
     # A second run finds the finished chunks and reproduces the table exactly.
     first = (out / "sweep.csv").read_text()
     assert main(args) == 0

@@ -191,6 +191,7 @@ def _write_csv(path, speeds, td, qs):
         "efficiency_percent": 100 * td.efficiency,
         "dte_rms_um": 1e6 * td.dte_rms,
         "status": td.status,
+        "back_contact_share": td.back_contact_share,
         "qs_power_loss_W": qs.power_loss,
         "qs_power_loss_sliding_W": qs.power_loss_sliding,
         "qs_power_loss_rolling_W": qs.power_loss_rolling,
@@ -224,6 +225,10 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
             "dte_rms_peak_high": _peak(speeds, td.dte_rms, 2600, 1e9),
             "points_not_converged": int(np.sum(~ok)),
             "points_on_attractor": int(np.sum(td.on_attractor)),
+            # back-flank strikes: their loss is not in Φ̄ (SimulationResult.back_contact_share)
+            "points_with_back_contact": int(
+                np.sum(ok & (np.nan_to_num(td.back_contact_share) > 0))
+            ),
             "wall_time_s": round(t_all, 2),
         },
         "inputs": {
@@ -251,4 +256,9 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
             if not good
         ],
         "on_attractor": [float(s) for s, on in zip(speeds, td.on_attractor) if on],
+        "back_contact": [
+            {"speed_rpm": float(s), "share": float(b)}
+            for s, b, good in zip(speeds, td.back_contact_share, ok)
+            if good and b > 0
+        ],
     }
