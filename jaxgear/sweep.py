@@ -45,6 +45,7 @@ _SCALARS = (
     "efficiency",
     "dte_rms",
     "fixed_point_residual",
+    "power_loss_back",
     "back_contact_share",
 )
 # Per-position outputs kept for every point (paper Figs. 5-7, 12 need them at chosen speeds).
@@ -58,8 +59,8 @@ class SweepResult(eqx.Module):
         inputs: dict of the varied inputs (SI; speed in rpm) [N].
         power_loss, power_loss_sliding, power_loss_rolling (W), efficiency, dte_rms (m),
         fixed_point_residual: [N] (NaN where a point failed).
-        back_contact_share: [N] share of the mesh cycle in back-flank contact, whose loss Φ̄ leaves
-            out (``SimulationResult.back_contact_share``; NaN where a point failed).
+        power_loss_back: [N] the back flanks' part of Φ̄, W; back_contact_share: [N] share of the
+            mesh cycle in back-flank contact (``SimulationResult``; NaN where a point failed).
         failed_contacts: [N] loaded contacts per point whose EHL solve failed (0 where a point's
             chunk failed: see ``status``).
         power_loss_position: Φ(t_i) per point, W [N, M].
@@ -80,6 +81,7 @@ class SweepResult(eqx.Module):
     dte_rms: np.ndarray
     fixed_point_residual: np.ndarray
     failed_contacts: np.ndarray
+    power_loss_back: np.ndarray
     back_contact_share: np.ndarray
     power_loss_position: np.ndarray
     tooth_force: np.ndarray
@@ -128,6 +130,7 @@ class SweepResult(eqx.Module):
             dte_rms_um=1e6 * np.asarray(self.dte_rms),
             fixed_point_residual=self.fixed_point_residual,
             failed_contacts=self.failed_contacts,
+            power_loss_back_W=self.power_loss_back,
             back_contact_share=self.back_contact_share,
             status=self.status,
         )
@@ -314,6 +317,7 @@ def sweep(
         dte_rms=np.asarray(out["dte_rms"]),
         fixed_point_residual=np.asarray(out["fixed_point_residual"]),
         failed_contacts=np.asarray(out["failed_contacts"]),
+        power_loss_back=np.asarray(out["power_loss_back"]),
         back_contact_share=np.asarray(out["back_contact_share"]),
         power_loss_position=np.asarray(out["power_loss_position"]),
         tooth_force=np.asarray(out["tooth_force"]),

@@ -28,7 +28,9 @@ from .dynamics.model import DynamicsOptions, MeshInterface
 from .dynamics.response import dte_harmonic_amplitudes, dynamic_response
 from .fidelity import Fidelity
 from .gear.geometry import gear_geometry, mesh_period
-from .gear.mesh import MeshCycle, mesh_cycle
+from .gear.load_sharing import DEFAULT_CONTACT_SMOOTHING
+from .gear.mesh import DEFAULT_EDGE_WIDTH, MeshCycle, _back_mesh, mesh_cycle
+from .gear.modification import DEFAULT_RELIEF_SMOOTHING
 from .gear.pair import GearPair
 from .lubrication.friction_models import XuFriction, smooth_sign
 from .lubrication.lubricant import Lubricant
@@ -273,11 +275,13 @@ class SimulationResult(eqx.Module):
         failed_contacts: loaded contacts of the cycle whose EHL solve failed (status 3); their
             outputs are carried over from the nearest good contact of the engagement, never used as
             they came out.
+        power_loss_back: the back flanks' part of Φ̄ (and of its sliding and rolling parts and
+            Φ(t)), W: where rattling teeth strike the back flanks on the attractor (status 6), their
+            contacts on the mirrored line of action (``_back_flank_power``); 0 elsewhere.
         back_contact_share: share of the mesh cycle with back-flank contact (the mesh deflection
             past the backlash, negative tooth forces; on status 6 over every recorded cycle of the
-            attractor). Those contacts' friction and loss are not modelled: Φ̄ counts the drive
-            flanks only, so where this is not 0 (rattling teeth that strike back, e.g. 3750-3900 rpm
-            of the calibrated pair) Φ̄ is short by the back flanks' loss. 0 when quasi-static.
+            attractor). A stable orbit with back contact would report it here with no back loss
+            (none on the calibrated pair's baseline). 0 when quasi-static.
     """
 
     power_loss: Float[Array, ""]
@@ -301,6 +305,7 @@ class SimulationResult(eqx.Module):
     fixed_point_residual: Float[Array, ""]
     fixed_point_iterations: Int[Array, ""]
     failed_contacts: Int[Array, ""]
+    power_loss_back: Float[Array, ""]
     back_contact_share: Float[Array, ""]
 
 
@@ -329,12 +334,57 @@ def _back_contact_share(load):
     return jnp.mean((jnp.sum(load, axis=-1) < 0.0).astype(load.dtype))
 
 
+def _back_flank_power(pair, op, fidelity, mesh, mesh_force, contacts):
+    """The back flanks' power loss per position [M] (sliding, rolling), W: the means over the
+    cycles of ``mesh_force`` [C, M] of the back-flank contacts where it is negative.
+
+    The back contacts stand where the mirror image of the drive mesh puts them
+    (``gear.mesh.back_flank_mesh``); the negative mesh force is shared among them by their
+    quasi-static load shares and solved by ``contacts(w, u, mesh)`` (the rung's contacts on the
+    attractor) at the kinematic surface velocities of their radii of curvature (the vibration's
+    velocities, which move the drive flanks' Φ̄ by < 0.4 %, are left out). Their friction does not
+    act on the dynamics."""
+    back_mesh = _back_mesh(
+        pair,
+        op.torque,
+        mesh.mesh_fraction,
+        fidelity.stiffness,
+        DEFAULT_EDGE_WIDTH,
+        DEFAULT_RELIEF_SMOOTHING,
+        DEFAULT_CONTACT_SMOOTHING,
+    )
+    u = kinematic_velocities(pair, back_mesh, op.omega1)
+
+    def one(fm):
+        w = back_mesh.load_share * jnp.maximum(-fm, 0.0)[:, None]
+        c = contacts(w, u, back_mesh)
+        return total_per_position(c.power_sliding), total_per_position(c.power_rolling)
+
+    sliding, rolling = jax.vmap(one)(mesh_force)
+    return jnp.mean(sliding, axis=0), jnp.mean(rolling, axis=0)
+
+
 def _assemble(
-    pair, op, mesh, forces, load, velocity, dte, status, residual, iterations, back_contact=None
+    pair,
+    op,
+    mesh,
+    forces,
+    load,
+    velocity,
+    dte,
+    status,
+    residual,
+    iterations,
+    back_contact=None,
+    back_power=None,
 ):
+    if back_power is None:
+        none = jnp.zeros(mesh.n_positions, dtype=load.dtype)
+        back_power = (none, none)
+    back_sliding, back_rolling = back_power
     power_pair = forces.power_sliding + forces.power_rolling
-    sliding = cycle_mean(total_per_position(forces.power_sliding))
-    rolling = cycle_mean(total_per_position(forces.power_rolling))
+    sliding = cycle_mean(total_per_position(forces.power_sliding) + back_sliding)
+    rolling = cycle_mean(total_per_position(forces.power_rolling) + back_rolling)
     loss = sliding + rolling
     dte_rms = jnp.sqrt(jnp.sum(dte_harmonic_amplitudes(dte) ** 2))
     values = jnp.stack([loss, dte_rms, jnp.sum(power_pair)])
@@ -345,7 +395,7 @@ def _assemble(
         power_loss_rolling=rolling,
         efficiency=efficiency(loss, op.torque, op.omega1),
         dte_rms=dte_rms,
-        power_loss_position=total_per_position(power_pair),
+        power_loss_position=total_per_position(power_pair) + back_sliding + back_rolling,
         power_loss_pair=power_pair,
         power_sliding_pair=forces.power_sliding,
         power_rolling_pair=forces.power_rolling,
@@ -361,6 +411,7 @@ def _assemble(
         fixed_point_residual=jnp.asarray(residual, dtype=loss.dtype),
         fixed_point_iterations=jnp.asarray(iterations, dtype=jnp.int32),
         failed_contacts=jnp.asarray(forces.failed, dtype=jnp.int32),
+        power_loss_back=cycle_mean(back_sliding + back_rolling),
         back_contact_share=(
             _back_contact_share(load) if back_contact is None else jnp.asarray(back_contact)
         ).astype(loss.dtype),
@@ -564,14 +615,27 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     )
     load, velocity, dte = state["load"], state["velocity"], state["dte"]
     attractor, on_attractor = jnp.zeros(13, dtype=zeros.dtype), jnp.zeros((), dtype=zeros.dtype)
-    back = _back_contact_share(load)
+    back, back_power = _back_contact_share(load), None
     if fidelity.attractor_periods > 0:
         warm_attractor = (warm.attractor, warm.on_attractor)
-        forces, load, velocity, dte, status, (attractor, on_attractor), back = _attractor_means(
-            pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
+        forces, load, velocity, dte, status, (attractor, on_attractor), back, back_power = (
+            _attractor_means(
+                pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
+            )
         )
     result = _assemble(
-        pair, op, mesh, forces, load, velocity, dte, status, residual, sol.stats["num_steps"], back
+        pair,
+        op,
+        mesh,
+        forces,
+        load,
+        velocity,
+        dte,
+        status,
+        residual,
+        sol.stats["num_steps"],
+        back,
+        back_power,
     )
     return result, WarmStart(
         interface=state["interface"],
@@ -638,8 +702,8 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
             jnp.where(continued, 0.0, DEFAULT_KICK),
         )
 
-        def contacts_at(w, u):
-            return _cycle_contacts(pair, lubricant, surfaces, op, fidelity, mesh, w, u)[0]
+        def contacts_on(m):
+            return lambda w, u: _cycle_contacts(pair, lubricant, surfaces, op, fidelity, m, w, u)[0]
 
         if fidelity.uses_ehl:
             # The closed-form mixed EHL contact (the "ehl_formula" rung) at each recorded load and
@@ -655,8 +719,8 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
             if fidelity.friction == "ehl_smooth":  # no asperity load on the smooth rung
                 surfaces = eqx.tree_at(lambda s: s.scale, surfaces, jnp.zeros_like(surfaces.scale))
 
-            def proxy(w, u):
-                return _cycle_contacts(pair, lubricant, surfaces, op, proxy_fid, mesh, w, u)[0]
+            def proxy(w, u, m=mesh):
+                return _cycle_contacts(pair, lubricant, surfaces, op, proxy_fid, m, w, u)[0]
 
             on_orbit = proxy(load, velocity)
             fields = (
@@ -674,8 +738,8 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
 
             ratios = {name: ratio(name) for name in fields}
 
-            def each(w, u):
-                c = proxy(w, u)
+            def each(w, u, m=mesh):
+                c = proxy(w, u, m)
                 scaled = {name: getattr(c, name) * ratios[name] for name in fields}
                 fs, fr = scaled["friction_sliding"], scaled["friction_rolling"]
                 loaded = w > 0
@@ -689,7 +753,9 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
                 )
 
         else:
-            each = contacts_at
+
+            def each(w, u, m=mesh):
+                return contacts_on(m)(w, u)
 
         # ATTRACTOR_CONTACT_CYCLES cycles spread over the whole record (the window's length, not
         # the sample count, sets the bias of the mean), one from every block of `stride`, at a
@@ -717,13 +783,20 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         back = jnp.where(
             ok, jnp.mean((rec.mesh_force < 0.0).astype(load.dtype)), _back_contact_share(load)
         )
-        return (*picked, status, handover, back)
+        back_power = _back_flank_power(
+            pair, op, fidelity, mesh, rec.mesh_force[pick], lambda w, u, m: each(w, u, m)
+        )
+        back_power = jax.tree_util.tree_map(
+            lambda a: jnp.where(ok & jnp.all(jnp.isfinite(a)), a, 0.0), back_power
+        )
+        return (*picked, status, handover, back, back_power)
 
     def keep(operand):
         *_, st, status, warm = operand
         off = (jnp.zeros_like(warm[0]), jnp.zeros_like(warm[1]))
         back = _back_contact_share(st["load"])
-        return st["forces"], st["load"], st["velocity"], st["dte"], status, off, back
+        none = jnp.zeros(mesh.n_positions, dtype=st["load"].dtype)
+        return st["forces"], st["load"], st["velocity"], st["dte"], status, off, back, (none, none)
 
     unstable = (state["dynamics_ok"] < 0.5) & jnp.all(jnp.isfinite(state["guess"]))
     # The branch is costly to compile (the dynamics in time): traced once, without the all-members

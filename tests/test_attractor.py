@@ -310,15 +310,15 @@ def test_forward_mode_gradient_with_the_attractor_branch_matches_central_differe
     assert float(g[1]) == pytest.approx(float(fd[1]), rel=1e-3)
 
 
-def test_back_flank_strikes_are_reported_from_the_record_not_the_mean_loads(at_3450):
+def test_back_flank_strikes_are_counted_from_the_record_not_the_mean_loads(at_3450):
     """Rattling teeth that cross the backlash strike the back flanks (negative tooth forces). The
-    model leaves those contacts' friction and loss out of Φ̄ and says how much of the cycle they
-    take (``back_contact_share``). At 3850 rpm (default fidelity) the attractor strikes back (the
-    frictionless dynamics alone: 0.18 of the record at 3800 rpm, a one-off run; docs/open_points.md,
-    back-flank contact). The share must come from the record's cycles: the mean tooth forces it
+    share of the cycle they take (``back_contact_share``) and their loss (``power_loss_back``,
+    part of Φ̄) come from the attractor's recorded cycles. At 3850 rpm (default fidelity) the
+    attractor strikes back (the frictionless dynamics alone: 0.18 of the record at 3800 rpm, a
+    one-off run; docs/open_points.md, back-flank contact), while the mean tooth forces the result
     reports are positive at every position (measured ≥ 5.3 kN: the strikes average out), so a
-    share from them would read 0. At 3450 rpm the teeth separate but do not strike back, and a
-    stable orbit (2500 rpm) and the quasi-static cycle carry none."""
+    share or a loss from them would read 0. At 3450 rpm the teeth separate but do not strike
+    back, and a stable orbit (2500 rpm) and the quasi-static cycle carry none."""
     lub, surf, fid = jg.presets.mil_l_23699(), jg.presets.ground(), jg.Fidelity()
     res, _ = _STEP(PAIR, lub, surf, _op(3850.0), fid, cold_start(fid.n_positions))
     assert int(res.status) == STATUS_ATTRACTOR
@@ -327,8 +327,17 @@ def test_back_flank_strikes_are_reported_from_the_record_not_the_mean_loads(at_3
     # measured 0.209 (fast(), in a continuation sweep: 0.11-0.23 over 3750-4000 rpm); the bounds
     # say "strikes a real share of the cycle", not a value (it moves with the attractor's window)
     assert 0.05 < float(res.back_contact_share) < 0.5
+    # Φ̄ is the drive flanks' cycle mean plus the back flanks' (measured: 41.5 W, 6.5 % of Φ̄);
+    # the drive part is the per-pair table's mean, to round-off
+    drive = float(jnp.mean(jnp.sum(res.power_loss_pair, axis=1)))
+    back = float(res.power_loss_back)
+    assert back > 0.02 * float(res.power_loss)
+    assert float(res.power_loss) == pytest.approx(drive + back, rel=1e-12)
+    assert float(jnp.mean(res.power_loss_position)) == pytest.approx(drive + back, rel=1e-12)
     assert float(at_3450[0].back_contact_share) == 0.0
+    assert float(at_3450[0].power_loss_back) == 0.0
     stable, _ = _STEP(PAIR, lub, surf, _op(2500.0), fid, cold_start(fid.n_positions))
     assert int(stable.status) == 0 and float(stable.back_contact_share) == 0.0
+    assert float(stable.power_loss_back) == 0.0
     qs = jg.simulate(PAIR, lub, surf, _op(3850.0), fid.replace(dynamics="quasi_static"))
-    assert float(qs.back_contact_share) == 0.0
+    assert float(qs.back_contact_share) == 0.0 and float(qs.power_loss_back) == 0.0

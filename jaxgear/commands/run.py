@@ -191,6 +191,7 @@ def _write_csv(path, speeds, td, qs):
         "efficiency_percent": 100 * td.efficiency,
         "dte_rms_um": 1e6 * td.dte_rms,
         "status": td.status,
+        "power_loss_back_W": td.power_loss_back,
         "back_contact_share": td.back_contact_share,
         "qs_power_loss_W": qs.power_loss,
         "qs_power_loss_sliding_W": qs.power_loss_sliding,
@@ -225,7 +226,7 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
             "dte_rms_peak_high": _peak(speeds, td.dte_rms, 2600, 1e9),
             "points_not_converged": int(np.sum(~ok)),
             "points_on_attractor": int(np.sum(td.on_attractor)),
-            # back-flank strikes: their loss is not in Φ̄ (SimulationResult.back_contact_share)
+            # rattling teeth striking the back flanks (SimulationResult.back_contact_share)
             "points_with_back_contact": int(
                 np.sum(ok & (np.nan_to_num(td.back_contact_share) > 0))
             ),
@@ -257,8 +258,8 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
         ],
         "on_attractor": [float(s) for s, on in zip(speeds, td.on_attractor) if on],
         "back_contact": [
-            {"speed_rpm": float(s), "share": float(b)}
-            for s, b, good in zip(speeds, td.back_contact_share, ok)
+            {"speed_rpm": float(s), "share": float(b), "power_loss_back_W": float(p)}
+            for s, b, p, good in zip(speeds, td.back_contact_share, td.power_loss_back, ok)
             if good and b > 0
         ],
     }

@@ -12,8 +12,11 @@ from ..material import reduced_modulus
 from .geometry import GearGeometry, gear_geometry, normal_load, radii_of_curvature
 from .load_sharing import DEFAULT_CONTACT_SMOOTHING, share_load
 from .modification import DEFAULT_RELIEF_SMOOTHING, relief_separation
-from .pair import GearPair
+from .pair import GearPair, involute
 from .stiffness import STIFFNESS_METHODS, pair_stiffness
+
+#: Tip edge rounding, as a fraction of the base pitch (``mesh_cycle``'s ``edge_width``).
+DEFAULT_EDGE_WIDTH = 0.01
 
 
 class MeshCycle(eqx.Module):
@@ -97,7 +100,7 @@ def mesh_cycle(
     n_positions: int = 64,
     *,
     stiffness: str = "potential_energy",
-    edge_width: float = 0.01,
+    edge_width: float = DEFAULT_EDGE_WIDTH,
     relief_smoothing: float = DEFAULT_RELIEF_SMOOTHING,
     contact_smoothing: float = DEFAULT_CONTACT_SMOOTHING,
 ) -> MeshCycle:
@@ -150,10 +153,92 @@ def mesh_cycle(
 def _mesh_cycle(
     pair, torque, n_positions, stiffness, edge_width, relief_smoothing, contact_smoothing
 ) -> MeshCycle:
-    geo = gear_geometry(pair)
     tau = jnp.arange(n_positions) / n_positions
+    return _mesh_at(
+        pair, torque, tau, tau, stiffness, edge_width, relief_smoothing, contact_smoothing
+    )
+
+
+def back_flank_phase(pair: GearPair, tau):
+    """The drive-flank phase whose contacts stand where the back flanks' do at drive phase ``tau``.
+
+    The back flanks of symmetric involute teeth touch on the other line of action (LOA2, the mirror
+    image of LOA1 in the line of centres), and the mirror image of their mesh is a drive-flank mesh
+    run backwards: a back contact at distance s′ from gear 1's base tangent point on LOA2 has the
+    radii of curvature, load sharing and sliding of a drive contact at s = s′, and moves towards
+    the start of the path as the gears turn on. For one tooth of gear 1 the two flanks' contacts
+    satisfy s + s′ = rb1 (2 α_w + 2 inv α + s_ref1/r_ref1) (the tooth's thickness s_ref1 =
+    m (π/2 + 2 x1 tan α) at its reference radius, in angle, plus each involute's roll from the
+    reference circle to the working pitch circle), so modulo the base pitch pb the back contacts at
+    phase τ are the drive contacts at phase τ′ = frac(c − τ), c = (s + s′ − 2 s_start)/pb. The
+    clearance is left out: the teeth are thinned by the backlash and turn through it before the
+    back flanks touch, which moves s′ by at most the clearance 2ℓ along the line (0.14 mm against
+    pb = 8.86 mm for the paper's pair). Tested against the tooth thickness of an involute built
+    through both contact points (tests/test_mesh.py)."""
+    geo = gear_geometry(pair)
+    alpha, alpha_w = pair.pressure_angle, geo.operating_pressure_angle
+    rb1, r_ref1 = geo.base_radius[0], geo.reference_pitch_radius[0]
+    thickness = pair.module * (jnp.pi / 2.0 + 2.0 * pair.profile_shift[0] * jnp.tan(alpha))
+    both = rb1 * (2.0 * alpha_w + 2.0 * involute(alpha) + thickness / r_ref1)
+    c = (both - 2.0 * geo.path_start) / geo.base_pitch
+    return jnp.mod(c - tau, 1.0)
+
+
+def back_flank_mesh(
+    pair: GearPair,
+    torque,
+    n_positions: int = 64,
+    *,
+    stiffness: str = "potential_energy",
+    edge_width: float = DEFAULT_EDGE_WIDTH,
+    relief_smoothing: float = DEFAULT_RELIEF_SMOOTHING,
+    contact_smoothing: float = DEFAULT_CONTACT_SMOOTHING,
+) -> MeshCycle:
+    """The back flanks' mesh at the drive cycle's M positions τ_i = i/M (``back_flank_phase``).
+
+    Where rattling teeth cross the backlash the back flanks carry the mesh force; this gives their
+    contacts' positions (along LOA2, from gear 1's base tangent point there), radii of curvature,
+    quasi-static load shares (tip relief and stiffness as on the drive flanks: symmetric teeth) and
+    Hertz fields, row i at the same instant as the drive cycle's row i. ``mesh_fraction`` is the
+    drive cycle's τ; the slots are those of the drive mesh at phase τ′ (slot 0 entered contact at
+    phase 0 of that cycle). Arguments as ``mesh_cycle``."""
+    check_instance("pair", pair, GearPair)
+    drive = mesh_cycle(
+        pair,
+        torque,
+        n_positions,
+        stiffness=stiffness,
+        edge_width=edge_width,
+        relief_smoothing=relief_smoothing,
+        contact_smoothing=contact_smoothing,
+    )
+    return _back_mesh(
+        pair,
+        jnp.asarray(torque, dtype=pair.module.dtype),
+        drive.mesh_fraction,
+        stiffness,
+        float(edge_width),
+        float(relief_smoothing),
+        float(contact_smoothing),
+    )
+
+
+@eqx.filter_jit
+def _back_mesh(pair, torque, tau, stiffness, edge_width, relief_smoothing, contact_smoothing):
+    phase = back_flank_phase(pair, tau)
+    return _mesh_at(
+        pair, torque, tau, phase, stiffness, edge_width, relief_smoothing, contact_smoothing
+    )
+
+
+def _mesh_at(
+    pair, torque, tau, phase, stiffness, edge_width, relief_smoothing, contact_smoothing
+) -> MeshCycle:
+    """The mesh quantities of the drive-flank contacts at phases ``phase`` [M], reported at
+    ``mesh_fraction`` = ``tau``."""
+    geo = gear_geometry(pair)
     slots = jnp.arange(2)
-    s = geo.path_start + (tau[:, None] + slots[None, :]) * geo.base_pitch  # [M, 2]
+    s = geo.path_start + (phase[:, None] + slots[None, :]) * geo.base_pitch  # [M, 2]
     weight = contact_weight(geo, s, edge_width)
     inside = (s >= geo.path_start) & (s <= geo.path_end)
     # Evaluate stiffness and relief at a clipped position so out-of-path slots stay finite.
