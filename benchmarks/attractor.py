@@ -90,7 +90,8 @@ def main(argv=None):
         table.append(
             f"| {speeds[i]:.0f} | {float(off.power_loss[i]):.1f} → {float(on.power_loss[i]):.1f} | "
             f"{100 * (float(on.power_loss[i]) / float(off.power_loss[i]) - 1):+.1f} % | "
-            f"{1e6 * float(off.dte_rms[i]):.1f} → {1e6 * float(on.dte_rms[i]):.1f} |"
+            f"{1e6 * float(off.dte_rms[i]):.1f} → {1e6 * float(on.dte_rms[i]):.1f} | "
+            f"{float(on.back_contact_share[i]):.2f} | {float(on.power_loss_back[i]):.1f} |"
         )
     n_att = int(changed.sum())
     extra = (sweeps["on"][2] - sweeps["off"][2]) / max(n_att, 1)
@@ -118,10 +119,13 @@ def main(argv=None):
             "(status 6; off: status 2, the unstable orbit). Wall time with compilation "
             f"{sweeps['on'][1]:.1f} s on, {sweeps['off'][1]:.1f} s off; compiled "
             f"{sweeps['on'][2]:.1f} s on, {sweeps['off'][2]:.1f} s off ({extra:.2f} s per "
-            "attractor speed).",
+            "attractor speed). Back contact: the share of the attractor's record with the back "
+            "flanks striking (`back_contact_share`); back loss: their part of the attractor's Φ̄ "
+            "(`power_loss_back`, counted since 2026-11-29).",
             "",
-            "| rpm | Φ̄ orbit → attractor (W) | change | DTE RMS orbit → attractor (µm) |",
-            "|---|---|---|---|",
+            "| rpm | Φ̄ orbit → attractor (W) | change | DTE RMS orbit → attractor (µm) | "
+            "back contact | back loss (W) |",
+            "|---|---|---|---|---|---|",
             *table,
         ]
     )
