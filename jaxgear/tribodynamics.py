@@ -661,8 +661,10 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     Returned per position: the means over those cycles of the contact outputs (so Φ̄ is the
     record's mean loss), tooth forces and velocities, and the DTE's mean over the whole record (its mesh harmonics are the record's). Status 6 (STATUS_ATTRACTOR), or the status kept
     where the record is not finite. Last, the share of the whole record's positions in back-flank
-    contact (``SimulationResult.back_contact_share``; the orbit's where the record is not finite). No derivative passes through the attractor (its means are not
-    smooth functions of the design).
+    contact (``SimulationResult.back_contact_share``; the orbit's where the record is not finite)
+    and the back flanks' power per position over the same cycles (``_back_flank_power``: sliding,
+    rolling; zeros where the record is not finite). No derivative passes through the attractor
+    (its means are not smooth functions of the design).
 
     ``warm``: (state [13], flag) of the previous point's attractor in a continuation sweep; where
     the flag is 1 the record starts from it, with ATTRACTOR_WARM_SETTLE cycles and no kick (the
@@ -783,9 +785,7 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         back = jnp.where(
             ok, jnp.mean((rec.mesh_force < 0.0).astype(load.dtype)), _back_contact_share(load)
         )
-        back_power = _back_flank_power(
-            pair, op, fidelity, mesh, rec.mesh_force[pick], lambda w, u, m: each(w, u, m)
-        )
+        back_power = _back_flank_power(pair, op, fidelity, mesh, rec.mesh_force[pick], each)
         back_power = jax.tree_util.tree_map(
             lambda a: jnp.where(ok & jnp.all(jnp.isfinite(a)), a, 0.0), back_power
         )
