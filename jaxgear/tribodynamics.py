@@ -364,24 +364,11 @@ def _back_flank_power(pair, op, fidelity, mesh, mesh_force, contacts):
     return jnp.mean(sliding, axis=0), jnp.mean(rolling, axis=0)
 
 
-def _assemble(
-    pair,
-    op,
-    mesh,
-    forces,
-    load,
-    velocity,
-    dte,
-    status,
-    residual,
-    iterations,
-    back_contact=None,
-    back_power=None,
-):
-    if back_power is None:
-        none = jnp.zeros(mesh.n_positions, dtype=load.dtype)
-        back_power = (none, none)
-    back_sliding, back_rolling = back_power
+def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, iterations, back=None):
+    """The SimulationResult; ``back``: (back_contact_share, (sliding, rolling) back-flank power
+    per position) from the attractor, or None (the share from ``load``, no back power)."""
+    none = jnp.zeros(mesh.n_positions, dtype=load.dtype)
+    back_contact, (back_sliding, back_rolling) = (None, (none, none)) if back is None else back
     power_pair = forces.power_sliding + forces.power_rolling
     sliding = cycle_mean(total_per_position(forces.power_sliding) + back_sliding)
     rolling = cycle_mean(total_per_position(forces.power_rolling) + back_rolling)
@@ -615,28 +602,14 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     )
     load, velocity, dte = state["load"], state["velocity"], state["dte"]
     attractor, on_attractor = jnp.zeros(13, dtype=zeros.dtype), jnp.zeros((), dtype=zeros.dtype)
-    back, back_power = _back_contact_share(load), None
+    back = None
     if fidelity.attractor_periods > 0:
         warm_attractor = (warm.attractor, warm.on_attractor)
-        forces, load, velocity, dte, status, (attractor, on_attractor), back, back_power = (
-            _attractor_means(
-                pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
-            )
+        forces, load, velocity, dte, status, (attractor, on_attractor), *back = _attractor_means(
+            pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
         )
-    result = _assemble(
-        pair,
-        op,
-        mesh,
-        forces,
-        load,
-        velocity,
-        dte,
-        status,
-        residual,
-        sol.stats["num_steps"],
-        back,
-        back_power,
-    )
+    its = sol.stats["num_steps"]
+    result = _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, its, back)
     return result, WarmStart(
         interface=state["interface"],
         orbit=state["guess"],
