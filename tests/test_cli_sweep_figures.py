@@ -59,6 +59,7 @@ def test_sweep_from_tiny_toml_writes_files(tmp_path, capsys):
     assert rows[0].startswith("speed_rpm,torque,power_loss_W") and len(rows) == 4
     summary = json.loads((out / "summary.json").read_text())
     assert summary["headline"]["points"] == 3 and summary["headline"]["points_not_converged"] == 0
+    assert summary["headline"]["points_with_back_contact"] == 0  # quasi-static: no rattle
     assert summary["inputs"]["sweep"]["vary"] == {"torque_Nm": [700.0, 700.0, 1500.0]}
     assert summary["fidelity"]["n_positions"] == 24
     loss = np.loadtxt(out / "sweep.csv", delimiter=",", skiprows=1, usecols=2)

@@ -146,6 +146,10 @@ def _summary(cfg, main, reference, t_main, t_all):
             "max_dte_rms_um": _nan_stat(np.nanmax, 1e6 * np.asarray(main.dte_rms)),
             "points_not_converged": int(np.sum(~ok)),
             "points_on_attractor": int(np.sum(main.on_attractor)),
+            # rattling teeth striking the back flanks (their loss: power_loss_back_W in the CSV)
+            "points_with_back_contact": int(
+                np.sum(ok & (np.nan_to_num(main.back_contact_share) > 0))
+            ),
             "wall_time_s": round(t_all, 2),
         },
         "inputs": cfg.echo,
