@@ -137,4 +137,8 @@ def test_back_flank_loss_at_the_static_load_converges_to_the_drive_flanks_of_any
         drive, back = _static_losses(pair, m)
         gaps.append(back / drive - 1.0)
     assert abs(gaps[-1]) < 0.02
-    assert 1.6 < gaps[0] / gaps[1] < 4.0 and 1.6 < gaps[1] / gaps[2] < 4.0
+    # Each doubling shrinks the gap by ~2 (first order); 1.6-4 admits the measured 2.5 and 2.4
+    # while failing a gap that stalls (ratio ~1: a wrong phase or load share would leave an O(1)
+    # offset) or falls at second order by a fluke of the grid (≥ 4).
+    for coarse, fine in zip(gaps[:-1], gaps[1:]):
+        assert 1.6 < coarse / fine < 4.0, gaps

@@ -119,6 +119,16 @@ def mesh_cycle(
     Returns:
         MeshCycle with arrays of shape [M] or [M, 2] (pair slots) as documented there.
     """
+    return _mesh_cycle(
+        *_checked(
+            pair, torque, n_positions, stiffness, edge_width, relief_smoothing, contact_smoothing
+        )
+    )
+
+
+def _checked(pair, torque, n_positions, stiffness, edge_width, relief_smoothing, contact_smoothing):
+    """``mesh_cycle``'s arguments validated (errors name the field, value and range) and
+    normalised for the compiled functions."""
     if isinstance(n_positions, bool) or not isinstance(n_positions, int) or n_positions < 4:
         raise ValueError(
             f"n_positions = {n_positions!r} is out of range; valid range: integer >= 4"
@@ -138,7 +148,7 @@ def mesh_cycle(
         raise ValueError(
             f"stiffness = {stiffness!r} is not valid; valid choices: {STIFFNESS_METHODS}"
         )
-    return _mesh_cycle(
+    return (
         pair,
         jnp.asarray(torque, dtype=pair.module.dtype),
         n_positions,
@@ -202,25 +212,10 @@ def back_flank_mesh(
     Hertz fields, row i at the same instant as the drive cycle's row i. ``mesh_fraction`` is the
     drive cycle's τ; the slots are those of the drive mesh at phase τ′ (slot 0 entered contact at
     phase 0 of that cycle). Arguments as ``mesh_cycle``."""
-    check_instance("pair", pair, GearPair)
-    drive = mesh_cycle(
-        pair,
-        torque,
-        n_positions,
-        stiffness=stiffness,
-        edge_width=edge_width,
-        relief_smoothing=relief_smoothing,
-        contact_smoothing=contact_smoothing,
+    pair, torque, m, *options = _checked(
+        pair, torque, n_positions, stiffness, edge_width, relief_smoothing, contact_smoothing
     )
-    return _back_mesh(
-        pair,
-        jnp.asarray(torque, dtype=pair.module.dtype),
-        drive.mesh_fraction,
-        stiffness,
-        float(edge_width),
-        float(relief_smoothing),
-        float(contact_smoothing),
-    )
+    return _back_mesh(pair, torque, jnp.arange(m) / m, *options)
 
 
 @eqx.filter_jit
