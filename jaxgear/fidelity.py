@@ -19,6 +19,8 @@ import dataclasses
 
 import equinox as eqx
 
+from .dynamics.model import BACK_FLANK_KINDS
+
 DYNAMICS_RUNGS = ("quasi_static", "tribo_dynamic")
 FRICTION_RUNGS = ("constant", "regression", "ehl_formula", "ehl_smooth", "ehl_mixed")
 COUPLING_RUNGS = ("frozen", "fixed_point")
@@ -80,6 +82,10 @@ class Fidelity(eqx.Module):
             iteration with ``relaxation``).
         backlash: "exact" or "smooth" backlash in the dynamics ("smooth" for gradients through
             contact loss).
+        back_flank: the back flanks' mesh stiffness and excitation in the dynamics, where
+            rattling teeth strike them: "mirrored" (the drive tables at the mirrored phase, where
+            the back contacts stand) or "same" (the drive side's km(t) at the same instant: the
+            usual single backlash function). See ``DynamicsOptions.back_flank``.
         mixed_model: roughness treatment of the "ehl_mixed" rung: "statistical" (Greenwood-Tripp
             asperity pressure with the mean film: robust in deep mixed lubrication) or
             "deterministic" (the roughness profiles in the film, unified Reynolds; it needs
@@ -145,6 +151,7 @@ class Fidelity(eqx.Module):
     max_fixed_point_iterations: int = _static(40)
     relaxation: float = _static(1.0)
     backlash: str = _static("exact")
+    back_flank: str = _static("mirrored")
     anderson_memory: int = _static(4)
     mixed_model: str = _static("statistical")
     shear: str = _static("eyring_paper")
@@ -160,6 +167,7 @@ class Fidelity(eqx.Module):
         _choice("Fidelity.coupling", self.coupling, COUPLING_RUNGS)
         _choice("Fidelity.stiffness", self.stiffness, STIFFNESS_METHODS)
         _choice("Fidelity.backlash", self.backlash, ("exact", "smooth"))
+        _choice("Fidelity.back_flank", self.back_flank, BACK_FLANK_KINDS)
         _choice("Fidelity.mixed_model", self.mixed_model, ("statistical", "deterministic"))
         _choice(
             "Fidelity.shear",

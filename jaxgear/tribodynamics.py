@@ -325,6 +325,7 @@ def _dynamics_options(fidelity: Fidelity) -> DynamicsOptions:
         steps_per_period=fidelity.steps_per_period,
         n_positions=fidelity.n_positions,
         backlash=fidelity.backlash,
+        back_flank=fidelity.back_flank,
     )
 
 
@@ -374,7 +375,11 @@ def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, ite
     rolling = cycle_mean(total_per_position(forces.power_rolling) + back_rolling)
     loss = sliding + rolling
     dte_rms = jnp.sqrt(jnp.sum(dte_harmonic_amplitudes(dte) ** 2))
-    values = jnp.stack([loss, dte_rms, jnp.sum(power_pair)])
+    # the tooth forces and the mesh too: a contact solver reads a NaN load as no contact (NaN > 0 is
+    # false), so a NaN position would otherwise drop out of Φ̄ silently
+    values = jnp.stack(
+        [loss, dte_rms, jnp.sum(power_pair), jnp.sum(load), jnp.sum(mesh.mesh_stiffness)]
+    )
     status = jnp.where(jnp.all(jnp.isfinite(values)), status, STATUS_NON_FINITE)
     return SimulationResult(
         power_loss=loss,

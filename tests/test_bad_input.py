@@ -243,6 +243,7 @@ def test_surfaces(field, kwargs, value):
         ("anderson_memory", dict(anderson_memory=-1), "-1"),
         ("anderson_memory", dict(anderson_memory=1.5), "1.5"),
         ("backlash", dict(backlash="soft"), "'soft'"),
+        ("back_flank", dict(back_flank="drive"), "'drive'"),
         ("stiffness", dict(stiffness="fem"), "'fem'"),
     ],
 )
@@ -263,6 +264,7 @@ def test_fidelity_presets():
     "field, kwargs, value",
     [
         ("backlash", dict(backlash="soft"), "'soft'"),
+        ("back_flank", dict(back_flank="drive"), "'drive'"),
         ("backlash_width", dict(backlash_width=0.0), "0"),
         ("newton_tol", dict(newton_tol=NAN), "nan"),
         ("steps_per_period", dict(steps_per_period=NAN), "nan"),

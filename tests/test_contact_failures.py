@@ -78,3 +78,26 @@ def test_coarse_transient_at_1500_nm_is_flagged_and_stays_physical():
     # term moves the cycle mean by ~1 % at this speed (tests/test_transient_coupling.py); 5 % allows
     # for the carried-over contacts.
     assert abs(float(marched.power_loss) / float(steady.power_loss) - 1.0) < 0.05
+
+
+def test_a_nan_tooth_force_is_reported_not_dropped_from_the_loss():
+    # The contact solvers read a NaN load as no contact (NaN > 0 is false), so a mesh position
+    # gone NaN (as one did where a pair without tip relief met a tip: 0/0 in the relief) once
+    # dropped out of Φ̄ with status 0 (519.4 W against 542.6 W for that 23/47 pair). The result
+    # must say non-finite instead.
+    import equinox as eqx
+
+    from jaxgear.fidelity import Fidelity
+    from jaxgear.tribodynamics import STATUS_NON_FINITE, STATUS_OK, _quasi_static
+
+    pair = jg.presets.li2015_pair()
+    fid = Fidelity(dynamics="quasi_static", friction="constant", n_positions=24)
+    op = jg.OperatingPoint(torque=700.0, speed_rpm=2000.0)
+    mesh = jg.mesh_cycle(pair, op.torque, 24)
+    args = (pair, jg.presets.mil_l_23699(), jg.presets.ground(), op, fid)
+    good = _quasi_static(*args, mesh)
+    assert int(good.status) == STATUS_OK
+    bad_mesh = eqx.tree_at(lambda m: m.normal_load, mesh, mesh.normal_load.at[3, 0].set(jnp.nan))
+    bad = _quasi_static(*args, bad_mesh)
+    assert int(bad.status) == STATUS_NON_FINITE
+    assert not bool(bad.converged)

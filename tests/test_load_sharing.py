@@ -123,3 +123,25 @@ def test_gradients_match_finite_differences(which):
     # ~1e-16/h relative to the values).
     np.testing.assert_allclose(jac, fd, rtol=1e-5, atol=1e-8 * float(jnp.max(jnp.abs(fd))))
     assert float(jnp.max(jnp.abs(jac))) > 0
+
+
+def test_pair_without_tip_relief_has_a_finite_mesh_where_the_path_meets_a_tip():
+    # A GearPair's default relief starts at the tip: no length. At a position where the contact
+    # stands exactly on a tip (here τ = 0 of a 23/47 pair with profile shifts, where the path
+    # starts at gear 2's tip to the last bit) its 0/0 once made the whole position NaN; the
+    # unshifted pair missed it only by round-off. With no relief the mesh must be the unrelieved
+    # one everywhere: finite, shares summing to 1 and no relief separation in the static TE.
+    pair = jg.GearPair(
+        teeth=(23, 47),
+        module=4e-3,
+        pressure_angle=math.radians(25.0),
+        face_width=0.03,
+        profile_shift=(0.3, -0.1),
+    )
+    mesh = jg.mesh_cycle(pair, 700.0, 32)
+    for name in ("mesh_stiffness", "static_te", "te_excitation", "normal_load"):
+        assert np.all(np.isfinite(np.asarray(getattr(mesh, name)))), name
+    np.testing.assert_allclose(mesh.load_share.sum(axis=1), 1.0, atol=1e-10)
+    # single contact at τ = 0 (slot 0 only just touching): W = k (d − 0), e = 0 there
+    k = float(mesh.pair_stiffness[0, 1])
+    assert float(mesh.static_te[0]) == pytest.approx(float(mesh.total_load) / k, rel=1e-6)

@@ -32,9 +32,18 @@ of both gears is exactly nominal (mean moment balance including the friction mom
 rigid-body rotation, free in Eq. 1, neither drifts nor needs an arbitrary spring.
 
 Backlash (clearance 2ℓ along the LOA): the rotation origin is the drive-flank touching position, so the
-tooth-contact function is δ(d + ℓ) with δ(x) = x − ℓ (x > ℓ, drive-side contact), 0 (|x| ≤ ℓ,
-separation), x + ℓ (x < −ℓ, back-side contact). In static equilibrium εd = r1φ1 + y1 − r2φ2 − y2 then equals
-the loaded static TE. ``backlash="smooth"`` replaces the kinks by softplus corners of width w.
+drive flanks are compressed by d = εd − e(τ) where d > 0 (εd = r1φ1 + y1 − r2φ2 − y2; in static
+equilibrium εd equals the loaded static TE), the back flanks by d_b = −εd − 2ℓ − e_b(τ) where d_b > 0,
+and the teeth are apart where neither is positive. The mesh force is
+Fm = km(τ)·⟨d⟩ − km_b(τ)·⟨d_b⟩ (⟨·⟩ the positive part). The back flanks mesh on the mirrored line of
+action, where the back contacts at phase τ are the drive contacts at phase frac(c − τ)
+(``gear.mesh.back_flank_phase``), so ``back_flank="mirrored"`` (the default) gives them the drive
+tables there: km_b(τ) = km(c − τ) and e_b(τ) = e(c − τ), the tip relief opening the clearance on the
+back flanks as on the drive flanks. ``back_flank="same"`` is the usual single backlash function
+δ(d + ℓ) of the drive side's km(τ) (δ(x) = x − ℓ above ℓ, 0 inside ±ℓ, x + ℓ below −ℓ), i.e.
+km_b(τ) = km(τ), e_b(τ) = −e(τ). Either way the back force acts along the drive line of action (its
+moment rb·Fm is right; its bearing components, along the other line of action, are not modelled).
+``backlash="smooth"`` replaces the kinks by softplus corners of width w.
 
 Tables (km, e and the mesh-interface sums) are interpolated in time by periodic cubic splines (C²), so the
 right-hand side is smooth between the M table points. The spline interpolates the data as given: a jump
@@ -54,6 +63,7 @@ from .._validation import check_finite, check_integer, check_non_negative, check
 
 BacklashKind = Literal["exact", "smooth"]
 BACKLASH_KINDS = ("exact", "smooth")
+BACK_FLANK_KINDS = ("mirrored", "same")
 
 #: Length scale of the dimensionless state (positions in µm).
 LENGTH_SCALE = 1e-6
@@ -110,6 +120,10 @@ class DynamicsOptions(eqx.Module):
             contact loss). Static.
         backlash_width: corner width w of the smooth backlash, m (default 0.1 µm, 0.3 % of the static
             mesh deflection of the paper's pair at 700 N m).
+        back_flank: the back flanks' stiffness and excitation where rattling teeth strike them (module
+            docstring): "mirrored" (default; the drive tables at the mirrored phase, where the back
+            contacts stand) or "same" (the drive side's km(τ) and relative deflection at the same
+            instant: the usual single backlash function). Static.
         steps_per_period: least number of fixed Runge-Kutta steps per mesh period. Static. The
             default 128 Tsit5 steps keep the DTE RMS of the paper's pair within ~1e-5 relative of a
             1024-step solve over 500-4200 rpm (benchmarks/dynamics.py prints the check).
@@ -132,6 +146,7 @@ class DynamicsOptions(eqx.Module):
 
     backlash: str = eqx.field(static=True, default="exact")
     backlash_width: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=1e-7)
+    back_flank: str = eqx.field(static=True, default="mirrored")
     steps_per_period: int = eqx.field(static=True, default=128)
     steps_per_mode_period: Float[Array, ""] = eqx.field(converter=jnp.asarray, default=16.0)
     max_steps_per_period: int = eqx.field(static=True, default=65536)
@@ -147,6 +162,11 @@ class DynamicsOptions(eqx.Module):
             raise ValueError(
                 f"DynamicsOptions.backlash = {self.backlash!r} is not valid; valid choices: "
                 + ", ".join(map(repr, BACKLASH_KINDS))
+            )
+        if self.back_flank not in BACK_FLANK_KINDS:
+            raise ValueError(
+                f"DynamicsOptions.back_flank = {self.back_flank!r} is not valid; valid choices: "
+                + ", ".join(map(repr, BACK_FLANK_KINDS))
             )
         check_positive("DynamicsOptions.backlash_width", self.backlash_width, "m")
         check_positive("DynamicsOptions.newton_tol", self.newton_tol)
@@ -211,7 +231,7 @@ class PeriodicSpline(eqx.Module):
         m = self.values.shape[0]
         u = (tau - jnp.floor(tau)) * m
         i = jnp.clip(jnp.floor(u).astype(jnp.int32), 0, m - 1)
-        s = u - i
+        s = (u - i)[..., None]  # τ of any shape: channels last
         j = (i + 1) % m
         h2 = 1.0 / m**2
         a = 1.0 - s
@@ -271,19 +291,44 @@ class GearDynamics(eqx.Module):
     step: Float[Array, ""]
     omega: Float[Array, "2"]
     tables: PeriodicSpline
+    back_phase: Float[Array, ""]
     backlash_width: Float[Array, ""]
     backlash: str = eqx.field(static=True)
+    back_flank: str = eqx.field(static=True)
 
     @property
     def equivalent_mass(self) -> Float[Array, "2"]:
         """J/r², kg: the rotations' inertia seen along the LOA."""
         return self.inertia / self.base_radius**2
 
-    def contact(self, x):
-        """δ(x) of the chosen backlash model (m)."""
+    def _positive(self, x):
+        """⟨x⟩ of the chosen backlash model: max(x, 0), or w·softplus(x/w) (m)."""
         if self.backlash == "exact":
-            return backlash_exact(x, self.half_clearance)
-        return backlash_smooth(x, self.half_clearance, self.backlash_width)
+            return jnp.maximum(x, 0.0)
+        return self.backlash_width * jax.nn.softplus(x / self.backlash_width)
+
+    def back_tables(self, tau):
+        """(km_b, e_b) of the back flanks at time fraction τ (N/m, m; module docstring)."""
+        if self.back_flank == "same":
+            tab = self.tables(tau)
+            return tab[..., _KM], -tab[..., _E]
+        tab = self.tables(self.back_phase - tau)
+        return tab[..., _KM], tab[..., _E]
+
+    def flank_compressions(self, tau, dte):
+        """(d, d_b): the drive and back flanks' compressions (m) at τ for the DTE εd = ``dte``
+        (m); each flank pair touches where its compression is positive."""
+        tab = self.tables(tau)
+        _, e_b = self.back_tables(tau)
+        return dte - tab[..., _E], -dte - 2.0 * self.half_clearance - e_b
+
+    def mesh_force(self, tau, dte):
+        """Fm = km⟨d⟩ − km_b⟨d_b⟩ (N) at τ for the DTE εd = ``dte`` (m): positive on the drive
+        flanks, negative on the back flanks."""
+        km = self.tables(tau)[..., _KM]
+        km_b, _ = self.back_tables(tau)
+        d, d_b = self.flank_compressions(tau, dte)
+        return km * self._positive(d) - km_b * self._positive(d_b)
 
     def load_torque(self, s):
         """T2 (N m) for the correction s."""
@@ -296,7 +341,7 @@ class GearDynamics(eqx.Module):
         return q, v
 
     def mesh_deflection(self, q, e):
-        """d = r1φ1 + y1 − r2φ2 − y2 − e (m), the argument of δ(d + ℓ)."""
+        """r1φ1 + y1 − r2φ2 − y2 − e (m): εd for e = 0, the drive flanks' compression for e(τ)."""
         return q[..., 0] + q[..., 1] - q[..., 3] - q[..., 4] - e
 
     def accelerations(self, tau, q, v, s):
@@ -305,8 +350,7 @@ class GearDynamics(eqx.Module):
         rb = self.base_radius
         dphi1 = v[0] / rb[0]
         dphi2 = v[3] / rb[1]
-        d = self.mesh_deflection(q, tab[_E])
-        fm = tab[_KM] * self.contact(d + self.half_clearance)
+        fm = self.mesh_force(tau, self.mesh_deflection(q, 0.0))
         # OLOA mesh damping on the vibratory sliding velocity (module docstring).
         dx1, dx2 = v[2], v[5]
         fd = -(tab[_C1] * dphi1 - tab[_C0] * dx1 - tab[_C2] * dphi2 + tab[_C0] * dx2)
@@ -340,6 +384,8 @@ def build_dynamics(
             f"MeshInterface has {interface.n_positions} positions but the MeshCycle has "
             f"{mesh.n_positions}; they must match"
         )
+    from ..gear.mesh import back_flank_phase
+
     geo = gear_geometry(pair)
     rb = geo.base_radius
     z1, z2 = pair.teeth
@@ -365,8 +411,10 @@ def build_dynamics(
         step=1.0 / n_steps,
         omega=jnp.stack([omega1, omega1 * z1 / z2]),
         tables=PeriodicSpline(interface_channels(mesh, interface)),
+        back_phase=back_flank_phase(pair, 0.0),
         backlash_width=options.backlash_width,
         backlash=options.backlash,
+        back_flank=options.back_flank,
     )
 
 

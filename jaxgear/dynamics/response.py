@@ -369,21 +369,24 @@ def dte_harmonic_amplitudes(dte, n_harmonics: int = N_HARMONICS):
 def _kinematics(dyn: GearDynamics, mesh, zs):
     """Physical response at the mesh positions from scaled states ``zs`` [..., M, 12]: displacement
     and velocity [..., M, 6], DTE εd and mesh deflection d [..., M], mesh force km δ [..., M], tooth
-    forces W_T [..., M, 2] (paper Eq. 2) and surface velocities uj [..., M, 2, 2] (paper Eq. 3)."""
+    forces W_T [..., M, 2] (paper Eq. 2) and surface velocities uj [..., M, 2, 2] (paper Eq. 3); d is
+    the drive flanks' compression and the back flanks' (``GearDynamics.flank_compressions``) [..., M]
+    each."""
     q, v = dyn.physical(zs)
     rb = dyn.base_radius
     rot_scale = jnp.stack([1 / rb[0], 1.0, 1.0, 1 / rb[1], 1.0, 1.0])
     displacement = q * rot_scale
     velocity = v * rot_scale
-    dte = q[..., 0] + q[..., 1] - q[..., 3] - q[..., 4]
-    d = dte - mesh.te_excitation
-    fm = mesh.mesh_stiffness * dyn.contact(d + dyn.half_clearance)
+    dte = dyn.mesh_deflection(q, 0.0)
+    tau = mesh.mesh_fraction
+    d, d_back = dyn.flank_compressions(tau, dte)
+    fm = dyn.mesh_force(tau, dte)
     tooth = mesh.normal_load / mesh.total_load * fm[..., None]
     arms = mesh.radius_of_curvature  # [M, pair, gear]
     speed = dyn.omega + velocity[..., jnp.array([0, 3])]  # θj' [..., M, gear]
     dx = velocity[..., jnp.array([2, 5])]  # xj' [..., M, gear]
     surf = arms * speed[..., None, :] - dx[..., None, :]
-    return displacement, velocity, dte, d, fm, tooth, surf
+    return displacement, velocity, dte, (d, d_back), fm, tooth, surf
 
 
 def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) -> DynamicResponse:
@@ -392,7 +395,7 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
     ts = jnp.arange(m + 1) / m
     zs = _integrate(dyn, w[:12], w[12], options, ts=ts)
     resid = jnp.max(jnp.abs(zs[-1] - zs[0])) / jnp.maximum(jnp.max(jnp.abs(zs)), 1e-30)
-    displacement, velocity, dte, d, fm, tooth, surf = _kinematics(dyn, mesh, zs[:-1])
+    displacement, velocity, dte, (d, d_back), fm, tooth, surf = _kinematics(dyn, mesh, zs[:-1])
     harm = dte_harmonic_amplitudes(dte)
     rms = jnp.sqrt(jnp.sum(harm**2))
     finite = jnp.all(jnp.isfinite(zs)) & jnp.isfinite(rms)
@@ -418,7 +421,7 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
         tooth_force=tooth,
         surface_velocity=surf,
         contact_loss=(d < 0.0).astype(float),
-        back_contact=(d < -2.0 * dyn.half_clearance).astype(float),
+        back_contact=(d_back > 0.0).astype(float),
         contact_lost=jnp.any(d < 0.0),
         dte_harmonics=harm,
         dte_rms=rms,
@@ -593,7 +596,7 @@ def record_attractor(
     # mean rigid speed over the record relative to the nominal pitch-line speed rb1 Ω1
     nominal = dyn.base_radius[0] * dyn.omega[0] * dyn.mesh_period / LENGTH_SCALE  # per cycle
     speed_error = drift / (record * nominal)
-    _, _, dte, d, fm, tooth, surf = _kinematics(dyn, mesh, zs)
+    _, _, dte, (d, _), fm, tooth, surf = _kinematics(dyn, mesh, zs)
     flat = dte.reshape(-1)
     harm = 2.0 * _safe_abs_complex(jnp.fft.rfft(flat) / flat.shape[0])
     harm = harm[record : record * N_HARMONICS + 1 : record]

@@ -13,6 +13,7 @@ everywhere, including at the start of the relief.
 from __future__ import annotations
 
 import jax
+import jax.numpy as jnp
 
 from .geometry import GearGeometry, roll_angles
 from .pair import GearPair
@@ -36,9 +37,12 @@ def relief_of_gear(
     tr = pair.tip_relief
     start = tr.start_roll_angle[gear]
     length = geo.roll_angle_tip[gear] - start
-    t = (roll_angle - start) / length
+    # A relief starting at the tip (a GearPair's default: none) has no length; its 0/0 at the tip
+    # would make the whole mesh position NaN (with the amount 0 as the factor), so it is zero there.
+    has_length = length > 0.0
+    t = (roll_angle - start) / jnp.where(has_length, length, 1.0)
     power = 1.0 if tr.shape[gear] == "linear" else 2.0
-    return tr.amount[gear] * smooth_ramp(t, smoothing) ** power
+    return jnp.where(has_length, tr.amount[gear] * smooth_ramp(t, smoothing) ** power, 0.0)
 
 
 def relief_separation(
