@@ -57,6 +57,7 @@ def _dynamics_rows():
         rows.append(
             f"| {rpm:.0f} | {int(orbit.status)} | {float(orbit.floquet_multiplier):.4f} | "
             f"{int(att.period)} | {float(att.contact_loss):.2f} | "
+            f"{float(np.mean(np.asarray(att.mesh_force) < 0.0)):.2f} | "
             f"{1e6 * float(orbit.dte_rms):.1f} → {1e6 * float(att.dte_rms):.1f} | "
             f"{1e6 * float(att.dte_rms_total):.1f} | "
             f"{100 * (float(np.mean(att.mesh_force)) / target - 1):+.2f} % |"
@@ -84,6 +85,9 @@ def main(argv=None):
         _, again = _sweep(fid, speeds + 1e-3)
         sweeps[name] = (res, wall, again)
     on, off = sweeps["on"][0], sweeps["off"][0]
+    # the back flanks with the drive side's km(t) at the same instant (the single backlash
+    # function, the model before 2026-11-29): what the mirrored back mesh changes
+    same, _ = _sweep(jg.Fidelity.fast(back_flank="same"), speeds)
     changed = np.asarray(on.status) == 6
     table = []
     for i in np.flatnonzero(changed):
@@ -91,7 +95,9 @@ def main(argv=None):
             f"| {speeds[i]:.0f} | {float(off.power_loss[i]):.1f} → {float(on.power_loss[i]):.1f} | "
             f"{100 * (float(on.power_loss[i]) / float(off.power_loss[i]) - 1):+.1f} % | "
             f"{1e6 * float(off.dte_rms[i]):.1f} → {1e6 * float(on.dte_rms[i]):.1f} | "
-            f"{float(on.back_contact_share[i]):.2f} | {float(on.power_loss_back[i]):.1f} |"
+            f"{float(on.back_contact_share[i]):.2f} | {float(on.power_loss_back[i]):.1f} | "
+            f"{float(same.power_loss[i]):.1f} ({float(same.back_contact_share[i]):.2f}, "
+            f"{float(same.power_loss_back[i]):.1f}) |"
         )
     n_att = int(changed.sum())
     extra = (sweeps["on"][2] - sweeps["off"][2]) / max(n_att, 1)
@@ -104,12 +110,14 @@ def main(argv=None):
             "Dynamics only (frictionless, undamped mesh, 32 positions; `attractor_response`, 2000 "
             "settling cycles, 256 recorded). Floquet: largest |multiplier| of the period-1 orbit; "
             "period 0: none up to 4 (a torus or a chaotic rattle); contact loss: share of the "
-            "recorded samples with the flanks apart; mean force: the record's mean mesh force "
+            "recorded samples with the drive flanks apart; back contact: the share with the back "
+            "flanks striking (their own mesh stiffness and relief at the mirrored phase, "
+            "`back_flank=\"mirrored\"`); mean force: the record's mean mesh force "
             "against T1/rb1, which the moment balance makes exact in the long-time limit.",
             "",
-            "| rpm | orbit status | Floquet | period | contact loss | DTE RMS orbit → attractor "
-            "(µm) | DTE total RMS (µm) | mean force − T1/rb1 |",
-            "|---|---|---|---|---|---|---|---|",
+            "| rpm | orbit status | Floquet | period | contact loss | back contact | DTE RMS orbit "
+            "→ attractor (µm) | DTE total RMS (µm) | mean force − T1/rb1 |",
+            "|---|---|---|---|---|---|---|---|---|",
             *rows,
             "",
             f"One attractor: {first:.1f} s with compilation, {run:.2f} s compiled.",
@@ -121,11 +129,13 @@ def main(argv=None):
             f"{sweeps['on'][2]:.1f} s on, {sweeps['off'][2]:.1f} s off ({extra:.2f} s per "
             "attractor speed). Back contact: the share of the attractor's record with the back "
             "flanks striking (`back_contact_share`); back loss: their part of the attractor's Φ̄ "
-            "(`power_loss_back`, counted since 2026-11-29).",
+            "(`power_loss_back`, counted since 2026-11-29). Last column: the attractor's Φ̄ "
+            "(back contact, back loss) with `back_flank=\"same\"`, the back flanks given the "
+            "drive side's km(t) at the same instant (the single backlash function).",
             "",
             "| rpm | Φ̄ orbit → attractor (W) | change | DTE RMS orbit → attractor (µm) | "
-            "back contact | back loss (W) |",
-            "|---|---|---|---|---|---|",
+            "back contact | back loss (W) | same: Φ̄ (back contact, back loss) |",
+            "|---|---|---|---|---|---|---|",
             *table,
         ]
     )

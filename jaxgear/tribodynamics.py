@@ -276,12 +276,12 @@ class SimulationResult(eqx.Module):
             outputs are carried over from the nearest good contact of the engagement, never used as
             they came out.
         power_loss_back: the back flanks' part of Φ̄ (and of its sliding and rolling parts and
-            Φ(t)), W: where rattling teeth strike the back flanks on the attractor (status 6), their
-            contacts on the mirrored line of action (``_back_flank_power``); 0 elsewhere.
+            Φ(t)), W: where rattling teeth strike the back flanks, on the attractor (status 6) or
+            on a periodic orbit, their contacts on the mirrored line of action
+            (``_back_flank_power``); 0 elsewhere.
         back_contact_share: share of the mesh cycle with back-flank contact (the mesh deflection
             past the backlash, negative tooth forces; on status 6 over every recorded cycle of the
-            attractor). A stable orbit with back contact would report it here with no back loss
-            (none on the calibrated pair's baseline). 0 when quasi-static.
+            attractor). 0 when quasi-static.
     """
 
     power_loss: Float[Array, ""]
@@ -367,7 +367,7 @@ def _back_flank_power(pair, op, fidelity, mesh, mesh_force, contacts):
 
 def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, iterations, back=None):
     """The SimulationResult; ``back``: (back_contact_share, (sliding, rolling) back-flank power
-    per position) from the attractor, or None (the share from ``load``, no back power)."""
+    per position) of the orbit or the attractor, or None (quasi-static: no back contact)."""
     none = jnp.zeros(mesh.n_positions, dtype=load.dtype)
     back_contact, (back_sliding, back_rolling) = (None, (none, none)) if back is None else back
     power_pair = forces.power_sliding + forces.power_rolling
@@ -607,12 +607,13 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     )
     load, velocity, dte = state["load"], state["velocity"], state["dte"]
     attractor, on_attractor = jnp.zeros(13, dtype=zeros.dtype), jnp.zeros((), dtype=zeros.dtype)
-    back = None
     if fidelity.attractor_periods > 0:
         warm_attractor = (warm.attractor, warm.on_attractor)
         forces, load, velocity, dte, status, (attractor, on_attractor), *back = _attractor_means(
             pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
         )
+    else:
+        back = _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, state)
     its = sol.stats["num_steps"]
     result = _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, its, back)
     return result, WarmStart(
@@ -622,6 +623,87 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         attractor=attractor,
         on_attractor=on_attractor,
     )
+
+
+def _record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st):
+    """``each(w, u, m=mesh)``: the rung's contacts at loads the fixed point did not solve (an
+    attractor's recorded cycles, the back flanks), given the fixed point's state ``st`` (its
+    ``load``, ``velocity`` and ``forces`` on the orbit): the closed-form rungs exactly, the EHL
+    rungs by the closed-form mixed EHL contact scaled to the rung's level on the orbit."""
+
+    if fidelity.uses_ehl:
+        # The closed-form mixed EHL contact (the "ehl_formula" rung) at each recorded load and
+        # velocity, scaled to this rung's level by the ratio of the two models' cycle totals
+        # on the orbit, per output (EHL solves at every recorded position would cost 64 × the
+        # fixed point's contacts; a forward-mode pass through them for power laws in the load,
+        # as the frozen coupling does, cost +80 s of compilation at the paper fidelity).
+        # Evaluated exactly, the closed form follows a rattle's loads from zero to impact
+        # (power laws from the orbit are extrapolated there, and carry no load to a slot the
+        # orbit leaves unloaded); it tracks the EHL solver's forces within 16 % at one contact
+        # (tests/test_ehl_formula.py) and Φ̄ within 6.1 % over the baseline sweep.
+        proxy_fid = fidelity.replace(friction="ehl_formula")
+        if fidelity.friction == "ehl_smooth":  # no asperity load on the smooth rung
+            surfaces = eqx.tree_at(lambda s: s.scale, surfaces, jnp.zeros_like(surfaces.scale))
+
+        def proxy(w, u, m=mesh):
+            return _cycle_contacts(pair, lubricant, surfaces, op, proxy_fid, m, w, u)[0]
+
+        on_orbit = proxy(st["load"], st["velocity"])
+        fields = (
+            "friction_sliding",
+            "friction_rolling",
+            "damping",
+            "power_sliding",
+            "power_rolling",
+        )
+
+        def ratio(name):
+            ehl = jnp.sum(jnp.abs(getattr(st["forces"], name)))
+            closed = jnp.sum(jnp.abs(getattr(on_orbit, name)))
+            return jnp.where(closed > 0, ehl / jnp.where(closed > 0, closed, 1.0), 0.0)
+
+        ratios = {name: ratio(name) for name in fields}
+
+        def each(w, u, m=mesh):
+            c = proxy(w, u, m)
+            scaled = {name: getattr(c, name) * ratios[name] for name in fields}
+            fs, fr = scaled["friction_sliding"], scaled["friction_rolling"]
+            loaded = w > 0
+            mu = jnp.where(
+                loaded, _safe_sqrt(fs * fs + fr * fr) / jnp.where(loaded, w, 1.0), 0.0
+            )
+            return eqx.tree_at(
+                lambda f: (*(getattr(f, n) for n in fields), f.friction_coefficient),
+                c,
+                (*scaled.values(), mu),
+            )
+
+    else:
+
+        def each(w, u, m=mesh):
+            return _cycle_contacts(pair, lubricant, surfaces, op, fidelity, m, w, u)[0]
+
+    return each
+
+
+def _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
+    """(back_contact_share, (sliding, rolling) back-flank power per position [M]) of the fixed
+    point's periodic orbit ``st``: its back-flank contacts, where its mesh force (the sum of its
+    tooth forces) is negative, solved as an attractor's (``_record_contacts``,
+    ``_back_flank_power``); zeros, at no cost on one point, where it has none (no periodic orbit
+    of the calibrated pair's baseline has any; a light load or a small backlash gives them)."""
+    force = jnp.sum(st["load"], axis=-1)[None]  # [1, M]
+
+    def strikes(_):
+        each = _record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st)
+        return _back_flank_power(pair, op, fidelity, mesh, force, each)
+
+    def none(_):
+        zero = jnp.zeros(mesh.n_positions, dtype=force.dtype)
+        return zero, zero
+
+    power = jax.lax.cond(jnp.any(force < 0.0), strikes, none, None)
+    return _back_contact_share(st["load"]), power
 
 
 def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm):
@@ -682,60 +764,7 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
             jnp.where(continued, 0.0, DEFAULT_KICK),
         )
 
-        def contacts_on(m):
-            return lambda w, u: _cycle_contacts(pair, lubricant, surfaces, op, fidelity, m, w, u)[0]
-
-        if fidelity.uses_ehl:
-            # The closed-form mixed EHL contact (the "ehl_formula" rung) at each recorded load and
-            # velocity, scaled to this rung's level by the ratio of the two models' cycle totals
-            # on the orbit, per output (EHL solves at every recorded position would cost 64 × the
-            # fixed point's contacts; a forward-mode pass through them for power laws in the load,
-            # as the frozen coupling does, cost +80 s of compilation at the paper fidelity).
-            # Evaluated exactly, the closed form follows a rattle's loads from zero to impact
-            # (power laws from the orbit are extrapolated there, and carry no load to a slot the
-            # orbit leaves unloaded); it tracks the EHL solver's forces within 16 % at one contact
-            # (tests/test_ehl_formula.py) and Φ̄ within 6.1 % over the baseline sweep.
-            proxy_fid = fidelity.replace(friction="ehl_formula")
-            if fidelity.friction == "ehl_smooth":  # no asperity load on the smooth rung
-                surfaces = eqx.tree_at(lambda s: s.scale, surfaces, jnp.zeros_like(surfaces.scale))
-
-            def proxy(w, u, m=mesh):
-                return _cycle_contacts(pair, lubricant, surfaces, op, proxy_fid, m, w, u)[0]
-
-            on_orbit = proxy(load, velocity)
-            fields = (
-                "friction_sliding",
-                "friction_rolling",
-                "damping",
-                "power_sliding",
-                "power_rolling",
-            )
-
-            def ratio(name):
-                ehl = jnp.sum(jnp.abs(getattr(st["forces"], name)))
-                closed = jnp.sum(jnp.abs(getattr(on_orbit, name)))
-                return jnp.where(closed > 0, ehl / jnp.where(closed > 0, closed, 1.0), 0.0)
-
-            ratios = {name: ratio(name) for name in fields}
-
-            def each(w, u, m=mesh):
-                c = proxy(w, u, m)
-                scaled = {name: getattr(c, name) * ratios[name] for name in fields}
-                fs, fr = scaled["friction_sliding"], scaled["friction_rolling"]
-                loaded = w > 0
-                mu = jnp.where(
-                    loaded, _safe_sqrt(fs * fs + fr * fr) / jnp.where(loaded, w, 1.0), 0.0
-                )
-                return eqx.tree_at(
-                    lambda f: (*(getattr(f, n) for n in fields), f.friction_coefficient),
-                    c,
-                    (*scaled.values(), mu),
-                )
-
-        else:
-
-            def each(w, u, m=mesh):
-                return contacts_on(m)(w, u)
+        each = _record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st)
 
         # ATTRACTOR_CONTACT_CYCLES cycles spread over the whole record (the window's length, not
         # the sample count, sets the bias of the mean), one from every block of `stride`, at a
@@ -770,11 +799,10 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         return (*picked, status, handover, back, back_power)
 
     def keep(operand):
-        *_, st, status, warm = operand
+        pair, lubricant, surfaces, op, mesh, st, status, warm = operand
         off = (jnp.zeros_like(warm[0]), jnp.zeros_like(warm[1]))
-        back = _back_contact_share(st["load"])
-        none = jnp.zeros(mesh.n_positions, dtype=st["load"].dtype)
-        return st["forces"], st["load"], st["velocity"], st["dte"], status, off, back, (none, none)
+        back = _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st)
+        return st["forces"], st["load"], st["velocity"], st["dte"], status, off, *back
 
     unstable = (state["dynamics_ok"] < 0.5) & jnp.all(jnp.isfinite(state["guess"]))
     # The branch is costly to compile (the dynamics in time): traced once, without the all-members

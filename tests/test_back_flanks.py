@@ -216,3 +216,44 @@ def test_reversed_torque_settles_on_the_back_flanks_static_te():
     assert err.max() < 0.2
     # the mean mesh force balances the reversed torque (mean moment balance, 1e-5: the ringing)
     assert float(np.mean(res.mesh_force)) == pytest.approx(-float(mesh.total_load), rel=1e-4)
+
+
+def test_a_periodic_orbit_that_strikes_the_back_flanks_counts_their_loss():
+    # With 5 µm of backlash (against the preset's 140 µm) the calibrated pair's stable periodic
+    # orbit at 3400 rpm strikes the back flanks over 22 % of the cycle (a dynamics sweep found no
+    # other such orbit over 500-4200 rpm, at 150-700 N m and 5-140 µm). Their loss, on the
+    # constant-μ rung Φ = μ Σ W us s (s = us/(us² + (0.02 um)²)^½: the rungs' sign of the sliding
+    # speed, smoothed over 2 % slide-to-roll ratio), is computed here apart from the model's
+    # machinery: the orbit's negative mesh force (the sum of its tooth forces) shared by the back
+    # mesh's quasi-static load shares, at the kinematic speeds of its radii of curvature.
+    import equinox as eqx
+
+    from jaxgear.tribodynamics import SIGN_SLIDE_TO_ROLL
+
+    pair = eqx.tree_at(lambda p: p.backlash, jg.presets.li2015_pair_calibrated(), 5e-6)
+    lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
+    fid = Fidelity(friction="constant", n_positions=32)
+    op = jg.OperatingPoint(torque=700.0, speed_rpm=3400.0)
+    res = jg.simulate(pair, lub, surf, op, fid)
+    assert int(res.status) == 0  # a stable periodic orbit, not an attractor
+    assert float(res.back_contact_share) > 0.1  # measured 0.22
+    force = np.asarray(res.tooth_force).sum(axis=1)
+    back = back_flank_mesh(pair, op.torque, 32)
+    omega1 = 3400.0 * math.pi / 30.0
+    omega2 = omega1 * pair.teeth[0] / pair.teeth[1]
+    rho = np.asarray(back.radius_of_curvature)
+    u1, u2 = rho[..., 0] * omega1, rho[..., 1] * omega2
+    us, um = u2 - u1, 0.5 * (u1 + u2)
+    sliding = us**2 / np.sqrt(us**2 + (SIGN_SLIDE_TO_ROLL * um) ** 2)
+    w = np.asarray(back.load_share) * np.maximum(-force, 0.0)[:, None]
+    expected = np.mean(np.sum(fid.constant_mu * w * sliding, axis=1))
+    assert expected > 0.02 * float(res.power_loss)  # measured 28.0 of 685.9 W
+    assert float(res.power_loss_back) == pytest.approx(expected, rel=1e-9)
+    drive = float(np.mean(np.sum(np.asarray(res.power_loss_pair), axis=1)))
+    assert float(res.power_loss) == pytest.approx(drive + float(res.power_loss_back), rel=1e-12)
+    # the same without the attractor branch (attractor_periods = 0 takes another path), and in a
+    # vmapped sweep beside a speed without back contact (3350 rpm)
+    off = jg.simulate(pair, lub, surf, op, fid.replace(attractor_periods=0))
+    assert float(off.power_loss_back) == pytest.approx(expected, rel=1e-9)
+    swept = jg.sweep(pair, lub, surf, op, speeds_rpm=[3350.0, 3400.0], fidelity=fid)
+    np.testing.assert_allclose(np.asarray(swept.power_loss_back), [0.0, expected], rtol=1e-9)
