@@ -112,7 +112,7 @@ def main(argv=None):
             "period 0: none up to 4 (a torus or a chaotic rattle); contact loss: share of the "
             "recorded samples with the drive flanks apart; back contact: the share with the back "
             "flanks striking (their own mesh stiffness and relief at the mirrored phase, "
-            "`back_flank=\"mirrored\"`); mean force: the record's mean mesh force "
+            '`back_flank="mirrored"`); mean force: the record\'s mean mesh force '
             "against T1/rb1, which the moment balance makes exact in the long-time limit.",
             "",
             "| rpm | orbit status | Floquet | period | contact loss | back contact | DTE RMS orbit "
@@ -130,7 +130,7 @@ def main(argv=None):
             "attractor speed). Back contact: the share of the attractor's record with the back "
             "flanks striking (`back_contact_share`); back loss: their part of the attractor's Φ̄ "
             "(`power_loss_back`, counted since 2026-11-29). Last column: the attractor's Φ̄ "
-            "(back contact, back loss) with `back_flank=\"same\"`, the back flanks given the "
+            '(back contact, back loss) with `back_flank="same"`, the back flanks given the '
             "drive side's km(t) at the same instant (the single backlash function).",
             "",
             "| rpm | Φ̄ orbit → attractor (W) | change | DTE RMS orbit → attractor (µm) | "

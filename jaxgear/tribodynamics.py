@@ -669,9 +669,7 @@ def _record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st):
             scaled = {name: getattr(c, name) * ratios[name] for name in fields}
             fs, fr = scaled["friction_sliding"], scaled["friction_rolling"]
             loaded = w > 0
-            mu = jnp.where(
-                loaded, _safe_sqrt(fs * fs + fr * fr) / jnp.where(loaded, w, 1.0), 0.0
-            )
+            mu = jnp.where(loaded, _safe_sqrt(fs * fs + fr * fr) / jnp.where(loaded, w, 1.0), 0.0)
             return eqx.tree_at(
                 lambda f: (*(getattr(f, n) for n in fields), f.friction_coefficient),
                 c,
