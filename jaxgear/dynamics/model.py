@@ -6,7 +6,8 @@ the deviations φj = θj − Ωj t. Because r1Ω1 = r2Ω2 the nominal rotation a
 deflection, and the torsional dampers ct act on the deviation speeds φj' (a damper on the absolute speed
 would be a constant drag of ct·Ω ≈ 3.7 kN m at 3500 rpm, far beyond the transmitted torque).
 
-Equations (paper Eq. 1; Fm = km(t)·δ(d) the mesh force, F1, F2 the total friction forces per pair):
+Equations (paper Eq. 1; Fm = km(t)·δ(d) the mesh force, F1, F2 the total friction forces per pair; the
+back flanks' force, below, adds to them along the other line of action):
 
     J1 φ1'' + ct1 φ1' + r1 Fm = T1 + Σn F1n R1n
     m1 y1'' + cy1 y1' + ky1 y1 + Fm = 0
@@ -33,17 +34,29 @@ rigid-body rotation, free in Eq. 1, neither drifts nor needs an arbitrary spring
 
 Backlash (clearance 2ℓ along the LOA): the rotation origin is the drive-flank touching position, so the
 drive flanks are compressed by d = εd − e(τ) where d > 0 (εd = r1φ1 + y1 − r2φ2 − y2; in static
-equilibrium εd equals the loaded static TE), the back flanks by d_b = −εd − 2ℓ − e_b(τ) where d_b > 0,
-and the teeth are apart where neither is positive. The mesh force is
-Fm = km(τ)·⟨d⟩ − km_b(τ)·⟨d_b⟩ (⟨·⟩ the positive part). The back flanks mesh on the mirrored line of
-action, where the back contacts at phase τ are the drive contacts at phase frac(c − τ)
-(``gear.mesh.back_flank_phase``), so ``back_flank="mirrored"`` (the default) gives them the drive
-tables there: km_b(τ) = km(c − τ) and e_b(τ) = e(c − τ), the tip relief opening the clearance on the
-back flanks as on the drive flanks. ``back_flank="same"`` is the usual single backlash function
-δ(d + ℓ) of the drive side's km(τ) (δ(x) = x − ℓ above ℓ, 0 inside ±ℓ, x + ℓ below −ℓ), i.e.
-km_b(τ) = km(τ), e_b(τ) = −e(τ). Either way the back force acts along the drive line of action (its
-moment rb·Fm is right; its bearing components, along the other line of action, are not modelled).
-``backlash="smooth"`` replaces the kinks by softplus corners of width w.
+equilibrium εd equals the loaded static TE). The back flanks touch on the other line of action LOA2,
+the mirror image of LOA1 in the line of centres, at 2α_w to it (α_w the working pressure angle), and
+are compressed by
+
+    d_b = −[(r1φ1 − r2φ2) + cos 2α_w (y1 − y2) − sin 2α_w (x1 − x2)] − 2ℓ − e_b(τ)
+
+where d_b > 0; the teeth are apart where neither compression is positive. The flank forces are
+f_d = km(τ)⟨d⟩ ≥ 0 along LOA1 and f_b = −km_b(τ)⟨d_b⟩ ≤ 0 along LOA2 (⟨·⟩ the positive part), and
+Fm = f_d + f_b is the mesh force of Eq. 1's rotation equations (both lines of action sit at rb
+from the centres). In the translation equations Fm is replaced by f_d + cos 2α_w f_b along y, and
+the x equations get +sin 2α_w f_b (gear 1) and −sin 2α_w f_b (gear 2): each force is −∂V/∂q of
+V = ½km⟨d⟩² + ½km_b⟨d_b⟩². (With the module's axes: e_y along LOA1 from the driver towards the
+driven gear, e_x against the surfaces' tangential motion at the drive contact, the force on gear 1
+is f_b (−cos 2α_w e_y + sin 2α_w e_x) = f_b e_2, e_2 the unit vector along LOA2 whose force has
+the driving moment; tests/test_back_flanks.py builds both in the plane of the gears.)
+
+The back contacts at phase τ are the drive contacts at phase frac(c − τ)
+(``gear.mesh.back_flank_phase``), so ``back_flank="mirrored"`` (the default) gives the back flanks
+the drive tables there: km_b(τ) = km(c − τ) and e_b(τ) = e(c − τ), the tip relief opening the
+clearance on the back flanks as on the drive flanks. ``back_flank="same"`` is the usual single
+backlash function δ(d + ℓ) of the drive side's km(τ) along LOA1 (δ(x) = x − ℓ above ℓ, 0 inside ±ℓ,
+x + ℓ below −ℓ): km_b(τ) = km(τ), e_b(τ) = −e(τ) and 2α_w → 0. ``backlash="smooth"`` replaces the
+kinks by softplus corners of width w.
 
 Tables (km, e and the mesh-interface sums) are interpolated in time by periodic cubic splines (C²), so the
 right-hand side is smooth between the M table points. The spline interpolates the data as given: a jump
@@ -293,6 +306,7 @@ class GearDynamics(eqx.Module):
     tables: PeriodicSpline
     back_tables: PeriodicSpline
     back_phase: Float[Array, ""]
+    back_angle: Float[Array, ""]
     backlash_width: Float[Array, ""]
     backlash: str = eqx.field(static=True)
     back_flank: str = eqx.field(static=True)
@@ -308,10 +322,21 @@ class GearDynamics(eqx.Module):
             return jnp.maximum(x, 0.0)
         return self.backlash_width * jax.nn.softplus(x / self.backlash_width)
 
-    def _flanks(self, tau, dte, tab=None):
-        """(km, d, km_b, d_b) at time fraction τ for the DTE εd = ``dte`` (m): the drive and back
-        flanks' stiffness (N/m) and compression (m; each flank pair touches where its compression
-        is positive). ``tab``: the tables at τ, if already evaluated."""
+    def back_direction(self):
+        """(cos 2α_w, sin 2α_w): the back flanks' line of action (LOA2) in the (y, x) axes (module
+        docstring); (1, 0) for ``back_flank="same"``, along the drive line of action."""
+        return jnp.cos(self.back_angle), jnp.sin(self.back_angle)
+
+    def back_deflection(self, q):
+        """(r1φ1 − r2φ2) + c (y1 − y2) − s (x1 − x2) (m), (c, s) = ``back_direction``: the
+        relative displacement along LOA2 that closes the back flanks' clearance when negative."""
+        c, s = self.back_direction()
+        return q[..., 0] - q[..., 3] + c * (q[..., 1] - q[..., 4]) - s * (q[..., 2] - q[..., 5])
+
+    def _flanks(self, tau, q, tab=None):
+        """(km, d, km_b, d_b) at time fraction τ for the displacements ``q`` [..., 6] (m): the
+        drive and back flanks' stiffness (N/m) and compression (m; each flank pair touches where
+        its compression is positive). ``tab``: the tables at τ, if already evaluated."""
         tab = self.tables(tau) if tab is None else tab
         km, e = tab[..., _KM], tab[..., _E]
         if self.back_flank == "same":
@@ -319,19 +344,22 @@ class GearDynamics(eqx.Module):
         else:
             back = self.back_tables(self.back_phase - tau)
             km_b, e_b = back[..., 0], back[..., 1]
-        return km, dte - e, km_b, -dte - 2.0 * self.half_clearance - e_b
+        d = self.mesh_deflection(q, e)
+        d_b = -self.back_deflection(q) - 2.0 * self.half_clearance - e_b
+        return km, d, km_b, d_b
 
-    def flank_compressions(self, tau, dte):
-        """(d, d_b): the drive and back flanks' compressions (m) at τ for the DTE εd = ``dte``
-        (m); each flank pair touches where its compression is positive."""
-        _, d, _, d_b = self._flanks(tau, dte)
+    def flank_compressions(self, tau, q):
+        """(d, d_b): the drive and back flanks' compressions (m) at τ for the displacements ``q``
+        [..., 6] (m); each flank pair touches where its compression is positive."""
+        _, d, _, d_b = self._flanks(tau, q)
         return d, d_b
 
-    def mesh_force(self, tau, dte, tab=None):
-        """Fm = km⟨d⟩ − km_b⟨d_b⟩ (N) at τ for the DTE εd = ``dte`` (m): positive on the drive
-        flanks, negative on the back flanks. ``tab``: the tables at τ, if already evaluated."""
-        km, d, km_b, d_b = self._flanks(tau, dte, tab)
-        return km * self._positive(d) - km_b * self._positive(d_b)
+    def flank_forces(self, tau, q, tab=None):
+        """(km⟨d⟩, −km_b⟨d_b⟩) (N) at τ for the displacements ``q`` [..., 6] (m): the drive
+        flanks' normal force (≥ 0, along LOA1) and the back flanks' (≤ 0, along LOA2); their sum
+        is the mesh force Fm whose moment is rb·Fm. ``tab``: the tables at τ, if evaluated."""
+        km, d, km_b, d_b = self._flanks(tau, q, tab)
+        return km * self._positive(d), -km_b * self._positive(d_b)
 
     def load_torque(self, s):
         """T2 (N m) for the correction s."""
@@ -353,7 +381,12 @@ class GearDynamics(eqx.Module):
         rb = self.base_radius
         dphi1 = v[0] / rb[0]
         dphi2 = v[3] / rb[1]
-        fm = self.mesh_force(tau, self.mesh_deflection(q, 0.0), tab)
+        f_drive, f_back = self.flank_forces(tau, q, tab)
+        fm = f_drive + f_back
+        # the back force acts along LOA2: cos 2α_w of it along y, sin 2α_w along x
+        c, s_back = self.back_direction()
+        fy = f_drive + c * f_back
+        fx = s_back * f_back
         # OLOA mesh damping on the vibratory sliding velocity (module docstring).
         dx1, dx2 = v[2], v[5]
         fd = -(tab[_C1] * dphi1 - tab[_C0] * dx1 - tab[_C2] * dphi2 + tab[_C0] * dx2)
@@ -363,11 +396,11 @@ class GearDynamics(eqx.Module):
         t2 = self.load_torque(s)
         m, j = self.mass, self.inertia
         ddphi1 = (t1 + tab[_F1R] + fd_r1 - self.ct[0] * dphi1 - rb[0] * fm) / j[0]
-        ddy1 = (-self.cy[0] * v[1] - self.ky[0] * q[1] - fm) / m[0]
-        ddx1 = (-self.cx[0] * v[2] - self.kx[0] * q[2] - (tab[_F1] + fd)) / m[0]
+        ddy1 = (-self.cy[0] * v[1] - self.ky[0] * q[1] - fy) / m[0]
+        ddx1 = (-self.cx[0] * v[2] - self.kx[0] * q[2] - (tab[_F1] + fd) + fx) / m[0]
         ddphi2 = (-t2 - tab[_F2R] - fd_r2 - self.ct[1] * dphi2 + rb[1] * fm) / j[1]
-        ddy2 = (-self.cy[1] * v[4] - self.ky[1] * q[4] + fm) / m[1]
-        ddx2 = (-self.cx[1] * v[5] - self.kx[1] * q[5] + (tab[_F2] + fd)) / m[1]
+        ddy2 = (-self.cy[1] * v[4] - self.ky[1] * q[4] + fy) / m[1]
+        ddx2 = (-self.cx[1] * v[5] - self.kx[1] * q[5] + (tab[_F2] + fd) - fx) / m[1]
         return jnp.stack([rb[0] * ddphi1, ddy1, ddx1, rb[1] * ddphi2, ddy2, ddx2])
 
     def __call__(self, tau, z, s):
@@ -419,6 +452,11 @@ def build_dynamics(
         # the dynamics ~15 %)
         back_tables=PeriodicSpline(channels[:, : _E + 1]),
         back_phase=back_flank_phase(pair, 0.0),
+        back_angle=(
+            2.0 * geo.operating_pressure_angle
+            if options.back_flank == "mirrored"
+            else jnp.zeros_like(geo.operating_pressure_angle)
+        ),
         backlash_width=options.backlash_width,
         backlash=options.backlash,
         back_flank=options.back_flank,

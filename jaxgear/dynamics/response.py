@@ -60,7 +60,8 @@ class DynamicResponse(eqx.Module):
         displacement: [M, 6] deviations (φ1 rad, y1 m, x1 m, φ2 rad, y2 m, x2 m) from nominal rotation.
         velocity: [M, 6] their time derivatives (rad/s, m/s).
         dynamic_te: εd = r1φ1 + y1 − r2φ2 − y2 (m) [M] (equals the static TE in static equilibrium).
-        mesh_force: km δ (N) [M].
+        mesh_force: Fm = km⟨d⟩ − km_b⟨d_b⟩, the drive and back flanks' forces (N) [M] (their
+            moment about each centre is rb·Fm; GearDynamics.flank_forces).
         tooth_force: dynamic tooth force per pair W_T = W_sT (r1/T1) km δ (paper Eq. 2), N [M, 2].
         surface_velocity: uj = Rj(Ωj + φj') − xj' per [position, pair, gear] (paper Eq. 3), m/s [M, 2, 2].
         contact_loss: 1.0 where the drive flanks separate (δ ≤ 0) [M]; back_contact: 1.0 on the back side.
@@ -379,8 +380,9 @@ def _kinematics(dyn: GearDynamics, mesh, zs):
     velocity = v * rot_scale
     dte = dyn.mesh_deflection(q, 0.0)
     tau = mesh.mesh_fraction
-    d, d_back = dyn.flank_compressions(tau, dte)
-    fm = dyn.mesh_force(tau, dte)
+    d, d_back = dyn.flank_compressions(tau, q)
+    f_drive, f_back = dyn.flank_forces(tau, q)
+    fm = f_drive + f_back
     tooth = mesh.normal_load / mesh.total_load * fm[..., None]
     arms = mesh.radius_of_curvature  # [M, pair, gear]
     speed = dyn.omega + velocity[..., jnp.array([0, 3])]  # θj' [..., M, gear]
