@@ -82,10 +82,11 @@ class Fidelity(eqx.Module):
             iteration with ``relaxation``).
         backlash: "exact" or "smooth" backlash in the dynamics ("smooth" for gradients through
             contact loss).
-        back_flank: the back flanks' mesh stiffness and excitation in the dynamics, where
-            rattling teeth strike them: "mirrored" (the drive tables at the mirrored phase, where
-            the back contacts stand) or "same" (the drive side's km(t) at the same instant: the
-            usual single backlash function). See ``DynamicsOptions.back_flank``.
+        back_flank: the back flanks' mesh stiffness, excitation and line of action in the
+            dynamics, where rattling teeth strike them: "mirrored" (the drive tables at the
+            mirrored phase, where the back contacts stand, the force along their own line of
+            action) or "same" (the drive side's km(t) at the same instant, along the drive line of
+            action: the usual single backlash function). See ``DynamicsOptions.back_flank``.
         mixed_model: roughness treatment of the "ehl_mixed" rung: "statistical" (Greenwood-Tripp
             asperity pressure with the mean film: robust in deep mixed lubrication) or
             "deterministic" (the roughness profiles in the film, unified Reynolds; it needs

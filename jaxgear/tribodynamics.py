@@ -688,8 +688,10 @@ def _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
     """(back_contact_share, (sliding, rolling) back-flank power per position [M]) of the fixed
     point's periodic orbit ``st``: its back-flank contacts, where its mesh force (the sum of its
     tooth forces) is negative, solved as an attractor's (``_record_contacts``,
-    ``_back_flank_power``); zeros, at no cost on one point, where it has none (no periodic orbit
-    of the calibrated pair's baseline has any; a light load or a small backlash gives them)."""
+    ``_back_flank_power``); zeros where it has none (no periodic orbit of the calibrated pair's
+    baseline has any; a light load or a small backlash gives them). A cond: a point without back
+    contact skips it, while a vmapped sweep runs it for every member (closed forms and the back
+    mesh, a small part of a point's cost)."""
     force = jnp.sum(st["load"], axis=-1)[None]  # [1, M]
 
     def strikes(_):

@@ -133,10 +133,11 @@ class DynamicsOptions(eqx.Module):
             contact loss). Static.
         backlash_width: corner width w of the smooth backlash, m (default 0.1 µm, 0.3 % of the static
             mesh deflection of the paper's pair at 700 N m).
-        back_flank: the back flanks' stiffness and excitation where rattling teeth strike them (module
-            docstring): "mirrored" (default; the drive tables at the mirrored phase, where the back
-            contacts stand) or "same" (the drive side's km(τ) and relative deflection at the same
-            instant: the usual single backlash function). Static.
+        back_flank: the back flanks' stiffness, excitation and line of action where rattling teeth
+            strike them (module docstring): "mirrored" (default; the drive tables at the mirrored
+            phase, where the back contacts stand, and the force along the back flanks' own line of
+            action) or "same" (the drive side's km(τ) and relative deflection at the same instant,
+            along the drive line of action: the usual single backlash function). Static.
         steps_per_period: least number of fixed Runge-Kutta steps per mesh period. Static. The
             default 128 Tsit5 steps keep the DTE RMS of the paper's pair within ~1e-5 relative of a
             1024-step solve over 500-4200 rpm (benchmarks/dynamics.py prints the check).

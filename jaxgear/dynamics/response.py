@@ -369,7 +369,7 @@ def dte_harmonic_amplitudes(dte, n_harmonics: int = N_HARMONICS):
 
 def _kinematics(dyn: GearDynamics, mesh, zs):
     """Physical response at the mesh positions from scaled states ``zs`` [..., M, 12]: displacement
-    and velocity [..., M, 6], DTE εd and mesh deflection d [..., M], mesh force km δ [..., M], tooth
+    and velocity [..., M, 6], DTE εd and mesh deflection d [..., M], mesh force Fm [..., M], tooth
     forces W_T [..., M, 2] (paper Eq. 2) and surface velocities uj [..., M, 2, 2] (paper Eq. 3); d is
     the drive flanks' compression and the back flanks' (``GearDynamics.flank_compressions``) [..., M]
     each."""
