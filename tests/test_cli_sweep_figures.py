@@ -365,3 +365,32 @@ def test_speed_e_joins_the_variant_speeds_only_between_them():
     # already a variant speed, or outside their range (a continuation sweep would jump): unchanged
     for e in (3300.0, 450.0, 4300.0):
         assert np.array_equal(_with_speed_e(v, e), v)
+
+
+def test_points_a_to_e_sit_at_the_resonances_not_in_a_back_flank_rattle():
+    # A-E go around the two DTE peaks (REFERENCE §6: A, B about the 1750 rpm one, D, E at the
+    # 3500 rpm one). A band where the teeth strike the back flanks (here 3950-4050 rpm, DTE above
+    # the resonance peak, as the calibrated pair's baseline has since the back flanks got their
+    # own stiffness and line of action) is a vibro-impact regime, not a resonance: it must not
+    # pull E out of the resonance; without its back-contact flag it would.
+    from types import SimpleNamespace
+
+    from jaxgear.figures import _place_points
+
+    speeds = np.arange(500.0, 4200.0 + 1e-9, 25.0)
+    dte = 5e-6 + 22e-6 * np.exp(-(((speeds - 1750.0) / 60.0) ** 2))
+    dte += 30e-6 * np.exp(-(((speeds - 3375.0) / 80.0) ** 2))
+    rattle = (speeds >= 3950.0) & (speeds <= 4050.0)
+    dte = np.where(rattle, 40e-6 + 6e-6 * (speeds - 3950.0) / 100.0, dte)  # up to 46 µm
+    fake = dict(
+        dte_rms=dte, converged=~rattle, on_attractor=rattle, back_contact_share=0.4 * rattle
+    )
+    points, source = _place_points(speeds, SimpleNamespace(**fake))
+    assert source == "peaks"
+    at = {k: float(speeds[i]) for k, i in points.items()}
+    assert at["E"] == 3375.0
+    assert at["D"] == 3325.0
+    assert at["A"] == 1700.0
+    assert at["B"] == 1800.0
+    unflagged = SimpleNamespace(**{**fake, "back_contact_share": np.zeros_like(dte)})
+    assert float(speeds[_place_points(speeds, unflagged)[0]["E"]]) == 4050.0  # the rattle's top
