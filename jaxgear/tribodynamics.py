@@ -689,20 +689,25 @@ def _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
     point's periodic orbit ``st``: its back-flank contacts, where its mesh force (the sum of its
     tooth forces) is negative, solved as an attractor's (``_record_contacts``,
     ``_back_flank_power``); zeros where it has none (no periodic orbit of the calibrated pair's
-    baseline has any; a light load or a small backlash gives them). A cond: a point without back
-    contact skips it, while a vmapped sweep runs it for every member (closed forms and the back
-    mesh, a small part of a point's cost)."""
+    baseline has any; a light load or a small backlash gives them). A vmap-lazy cond: a sweep
+    none of whose points strikes back skips it (run for every member, it cost the 149-speed
+    parallel sweep at ``Fidelity.fast()`` 12 %: 40.5 against 36.0 s compiled)."""
+    from ._lazy_cond import cond_any_member
+
     force = jnp.sum(st["load"], axis=-1)[None]  # [1, M]
 
-    def strikes(_):
+    def strikes(operand):
+        pair, lubricant, surfaces, op, mesh, st, force = operand
         each = _record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st)
         return _back_flank_power(pair, op, fidelity, mesh, force, each)
 
-    def none(_):
-        zero = jnp.zeros(mesh.n_positions, dtype=force.dtype)
+    def none(operand):
+        force = operand[-1]
+        zero = jnp.zeros(force.shape[-1], dtype=force.dtype)
         return zero, zero
 
-    power = jax.lax.cond(jnp.any(force < 0.0), strikes, none, None)
+    operand = (pair, lubricant, surfaces, op, mesh, st, force)
+    power = cond_any_member(jnp.any(force < 0.0), strikes, none, operand, all_true_path=False)
     return _back_contact_share(st["load"]), power
 
 
