@@ -17,6 +17,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from jaxgear.dynamics.model import BACK_FLANK_KINDS
 from jaxgear.fidelity import NAMED_PRESETS
 
 
@@ -50,6 +51,14 @@ def register(sub) -> None:
         metavar="RPM",
         help="step of the variant sweeps (60 °C, 1500 N m, polished, iso-thermal), a multiple of "
         "--speed-step (default 100, or --speed-step if larger)",
+    )
+    p.add_argument(
+        "--back-flank",
+        choices=BACK_FLANK_KINDS,
+        default=None,
+        help="the back flanks in the dynamics (default: the preset's; paper and paper_calibrated: "
+        "same, the paper's single backlash function; fast: mirrored, their own stiffness and line "
+        "of action). See jg.Fidelity.back_flank",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
@@ -85,11 +94,12 @@ def run(args: argparse.Namespace) -> int:
             )
             return 2
         variant_speeds = speeds[:: int(round(ratio))]
+    changes = {} if args.back_flank is None else {"back_flank": args.back_flank}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     repro = reproduce_paper(
-        Fidelity.named(args.fidelity),
+        Fidelity.named(args.fidelity, **changes),
         quick=args.quick,
         speeds_rpm=speeds,
         variant_speeds_rpm=variant_speeds,
