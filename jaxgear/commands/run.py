@@ -215,7 +215,10 @@ def _peak(speeds, values, lo, hi):
 
 
 def _summary(speeds, td, qs, fid, args, t_td, t_all):
+    from jaxgear.figures import _resonance_dte
+
     ok = ~td.failed
+    resonance = _resonance_dte(td)
     return {
         "headline": {
             "speeds_rpm": [float(speeds[0]), float(speeds[-1]), len(speeds)],
@@ -224,6 +227,10 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
             "max_power_loss_W": float(np.nanmax(td.power_loss)),
             "dte_rms_peak_low": _peak(speeds, td.dte_rms, 0, 2600),
             "dte_rms_peak_high": _peak(speeds, td.dte_rms, 2600, 1e9),
+            # the same among the speeds whose teeth do not strike the back flanks: the mesh
+            # resonances' peaks, apart from a back-flank rattle's larger DTE (figures' R1)
+            "dte_rms_resonance_peak_low": _peak(speeds, resonance, 0, 2600),
+            "dte_rms_resonance_peak_high": _peak(speeds, resonance, 2600, 1e9),
             "points_not_converged": int(np.sum(~ok)),
             "points_on_attractor": int(np.sum(td.on_attractor)),
             # rattling teeth striking the back flanks (SimulationResult.back_contact_share)
@@ -247,6 +254,7 @@ def _summary(speeds, td, qs, fid, args, t_td, t_all):
                     "n_positions",
                     "n_nodes",
                     "steps_per_period",
+                    "back_flank",
                 )
             },
         },
