@@ -21,6 +21,7 @@ Schema (every table and key optional; missing ``[gear]`` means the paper's pair)
     backlash_mm = 0.14
     blank_mass_kg = [2.77, 2.77]
     blank_inertia_kgm2 = [7.8e-3, 7.8e-3]
+    mesh_damping_ratio = 0.0     # viscous damping along the line of action (0: the paper's model)
 
     [gear.tip_relief]
     amount_um = 10.0             # scalar or [gear 1, gear 2]
@@ -69,6 +70,7 @@ _GEAR_KEYS = {
     "backlash_mm": float,
     "blank_mass_kg": (float, list),
     "blank_inertia_kgm2": (float, list),
+    "mesh_damping_ratio": float,
     "tip_relief": dict,
     "bearings": dict,
 }
@@ -199,6 +201,7 @@ def gear_pair_from_config(cfg: dict[str, Any], default_preset: str = "li2015") -
         "backlash_mm": ("backlash", 1e-3),
         "blank_mass_kg": ("blank_mass", 1.0),
         "blank_inertia_kgm2": ("blank_inertia", 1.0),
+        "mesh_damping_ratio": ("mesh_damping_ratio", 1.0),
     }
     for key, (name, factor) in simple.items():
         if key in gear:
@@ -283,6 +286,7 @@ _VARY_KEYS = {
     "inlet_temperature_C": ("inlet_temperature", 1.0, 273.15),
     "roughness_scale": ("roughness_scale", 1.0, 0.0),
     "tip_relief_um": ("tip_relief_amount", 1e-6, 0.0),
+    "mesh_damping_ratio": ("mesh_damping_ratio", 1.0, 0.0),
 }
 MAX_SWEEP_POINTS = 100_000
 
@@ -496,6 +500,8 @@ def _vary(table, n) -> tuple[dict, dict]:
             check_positive(where, arr, "N m")
         elif key == "inlet_temperature_C":
             check_range(where, arr, -73.15, 326.85, unit="°C")
+        elif key == "mesh_damping_ratio":
+            check_range(where, arr, 0.0, 1.0, high_inclusive=False)
         else:
             check_non_negative(where, arr)
         name, factor, offset = _VARY_KEYS[key]
@@ -517,7 +523,8 @@ def sweep_from_config(cfg: dict[str, Any], fidelity: str | None = None) -> Sweep
       interrupted sweep resumes); ``quasi_static_reference`` (default true for a tribo-dynamic sweep:
       also sweep the quasi-static model, as the paper's Fig. 4 compares them); ``progress`` (default
       true); ``[sweep.vary]``: ``torque_Nm``, ``inlet_temperature_C``, ``roughness_scale``,
-      ``tip_relief_um`` per speed (a list as long as the speeds) or one value.
+      ``tip_relief_um``, ``mesh_damping_ratio`` per speed (a list as long as the speeds) or one
+      value.
 
     Raises ValueError naming the key, the value and the valid range.
     """

@@ -36,6 +36,7 @@ SWEEPABLE = (
     "roughness_scale",
     "tip_relief_amount",
     "backlash",
+    "mesh_damping_ratio",
 )
 
 _SCALARS = (
@@ -47,6 +48,7 @@ _SCALARS = (
     "fixed_point_residual",
     "power_loss_back",
     "back_contact_share",
+    "mesh_damping_power",
 )
 # Per-position outputs kept for every point (paper Figs. 5-7, 12 need them at chosen speeds).
 _PER_POSITION = ("power_loss_position", "tooth_force", "surface_velocity", "hertz_pressure")
@@ -61,6 +63,7 @@ class SweepResult(eqx.Module):
         fixed_point_residual: [N] (NaN where a point failed).
         power_loss_back: [N] the back flanks' part of Φ̄, W; back_contact_share: [N] share of the
             mesh cycle in back-flank contact (``SimulationResult``; NaN where a point failed).
+        mesh_damping_power: [N] the mesh damper's mean power, W (``SimulationResult``; not in Φ̄).
         failed_contacts: [N] loaded contacts per point whose EHL solve failed (0 where a point's
             chunk failed: see ``status``).
         power_loss_position: Φ(t_i) per point, W [N, M].
@@ -83,6 +86,7 @@ class SweepResult(eqx.Module):
     failed_contacts: np.ndarray
     power_loss_back: np.ndarray
     back_contact_share: np.ndarray
+    mesh_damping_power: np.ndarray
     power_loss_position: np.ndarray
     tooth_force: np.ndarray
     surface_velocity: np.ndarray
@@ -132,6 +136,7 @@ class SweepResult(eqx.Module):
             failed_contacts=self.failed_contacts,
             power_loss_back_W=self.power_loss_back,
             back_contact_share=self.back_contact_share,
+            mesh_damping_power_W=self.mesh_damping_power,
             status=self.status,
         )
         names = list(cols)
@@ -157,6 +162,9 @@ def _apply(pair, surfaces, op, point):
         pair = eqx.tree_at(lambda p: p.tip_relief.amount, pair, amount)
     if "backlash" in point:
         pair = eqx.tree_at(lambda p: p.backlash, pair, jnp.asarray(point["backlash"]))
+    if "mesh_damping_ratio" in point:
+        ratio = jnp.asarray(point["mesh_damping_ratio"])
+        pair = eqx.tree_at(lambda p: p.mesh_damping_ratio, pair, ratio)
     return pair, surfaces, op
 
 
@@ -229,8 +237,8 @@ def sweep(
         devices: devices to shard parallel chunks over (default all local devices).
         **vary: other inputs per point, from ``SWEEPABLE``: torque (N m), inlet_temperature (K),
             roughness_scale, tip_relief_amount (m, both gears), backlash (m, total clearance 2ℓ
-            along the line of action: small values bring back-side impacts); arrays of length N or
-            scalars.
+            along the line of action: small values bring back-side impacts), mesh_damping_ratio
+            (ζ, ``GearPair.mesh_damping_ratio``); arrays of length N or scalars.
 
     Returns:
         SweepResult with per-point status; every good point is kept when others fail.
@@ -319,6 +327,7 @@ def sweep(
         failed_contacts=np.asarray(out["failed_contacts"]),
         power_loss_back=np.asarray(out["power_loss_back"]),
         back_contact_share=np.asarray(out["back_contact_share"]),
+        mesh_damping_power=np.asarray(out["mesh_damping_power"]),
         power_loss_position=np.asarray(out["power_loss_position"]),
         tooth_force=np.asarray(out["tooth_force"]),
         surface_velocity=np.asarray(out["surface_velocity"]),
@@ -346,6 +355,10 @@ def _validate_points(pair, surfaces, op, inputs):
         check_range("tip_relief_amount", inputs["tip_relief_amount"], 0.0, top, unit="m")
     if "backlash" in inputs:
         check_non_negative("backlash", inputs["backlash"], "m")
+    if "mesh_damping_ratio" in inputs:
+        check_range(
+            "mesh_damping_ratio", inputs["mesh_damping_ratio"], 0.0, 1.0, high_inclusive=False
+        )
 
 
 __all__ = ["SWEEPABLE", "SweepResult", "sweep", "POINT_STATUS_NAMES"]

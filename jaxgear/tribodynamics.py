@@ -282,6 +282,11 @@ class SimulationResult(eqx.Module):
         back_contact_share: share of the mesh cycle with back-flank contact (the mesh deflection
             past the backlash, negative tooth forces; on status 6 over every recorded cycle of the
             attractor). 0 when quasi-static.
+        mesh_damping_power: mean power the viscous mesh damper along the line of action
+            dissipates, W (``GearPair.mesh_damping_ratio``; 0 without it, and when quasi-static):
+            vibration energy turned into heat in the mesh, not friction, so not part of Φ̄ or Ψ
+            (the paper's loss is the friction's; neither are the bearings' and torsional
+            dampers'). On status 6 the attractor record's mean.
     """
 
     power_loss: Float[Array, ""]
@@ -307,6 +312,7 @@ class SimulationResult(eqx.Module):
     failed_contacts: Int[Array, ""]
     power_loss_back: Float[Array, ""]
     back_contact_share: Float[Array, ""]
+    mesh_damping_power: Float[Array, ""]
 
 
 def kinematic_velocities(pair: GearPair, mesh: MeshCycle, omega1):
@@ -365,9 +371,12 @@ def _back_flank_power(pair, op, fidelity, mesh, mesh_force, contacts):
     return jnp.mean(sliding, axis=0), jnp.mean(rolling, axis=0)
 
 
-def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, iterations, back=None):
+def _assemble(
+    pair, op, mesh, forces, load, velocity, dte, status, residual, iterations, back=None, damper=0.0
+):
     """The SimulationResult; ``back``: (back_contact_share, (sliding, rolling) back-flank power
-    per position) of the orbit or the attractor, or None (quasi-static: no back contact)."""
+    per position) of the orbit or the attractor, or None (quasi-static: no back contact);
+    ``damper``: the mesh damper's mean power (W)."""
     none = jnp.zeros(mesh.n_positions, dtype=load.dtype)
     back_contact, (back_sliding, back_rolling) = (None, (none, none)) if back is None else back
     power_pair = forces.power_sliding + forces.power_rolling
@@ -407,6 +416,7 @@ def _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, ite
         back_contact_share=(
             _back_contact_share(load) if back_contact is None else jnp.asarray(back_contact)
         ).astype(loss.dtype),
+        mesh_damping_power=jnp.asarray(damper, dtype=loss.dtype),
     )
 
 
@@ -507,6 +517,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             "load": load,
             "velocity": u,
             "dte": jnp.where(finite, resp.dynamic_te, state["dte"]),
+            "damper": jnp.where(finite, resp.mesh_damping_power, state["damper"]),
             "forces": forces,
             "dynamics_ok": jnp.where(finite & (resp.status == 0), 1.0, 0.0),
             "started": jnp.where(finite, 1.0, 0.0) * jnp.ones_like(state["started"]),
@@ -546,6 +557,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         "load": mesh.normal_load,
         "velocity": velocity0,
         "dte": mesh.static_te,
+        "damper": jnp.zeros((), dtype=zeros.dtype),
         "forces": forces0,
         "contacts": jax.lax.stop_gradient(contacts0),
         "dynamics_ok": jnp.asarray(1.0, dtype=zeros.dtype),
@@ -606,16 +618,21 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         ),
     )
     load, velocity, dte = state["load"], state["velocity"], state["dte"]
+    damper = state["damper"]
     attractor, on_attractor = jnp.zeros(13, dtype=zeros.dtype), jnp.zeros((), dtype=zeros.dtype)
     if fidelity.attractor_periods > 0:
         warm_attractor = (warm.attractor, warm.on_attractor)
-        forces, load, velocity, dte, status, (attractor, on_attractor), *back = _attractor_means(
-            pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
+        (forces, load, velocity, dte, damper), status, (attractor, on_attractor), *back = (
+            _attractor_means(
+                pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm_attractor
+            )
         )
     else:
         back = _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, state)
     its = sol.stats["num_steps"]
-    result = _assemble(pair, op, mesh, forces, load, velocity, dte, status, residual, its, back)
+    result = _assemble(
+        pair, op, mesh, forces, load, velocity, dte, status, residual, its, back, damper
+    )
     return result, WarmStart(
         interface=state["interface"],
         orbit=state["guess"],
@@ -723,8 +740,10 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     then the contacts are evaluated at every recorded position of ATTRACTOR_CONTACT_CYCLES cycles
     spread over the record: exactly on the closed-form rungs; on the EHL rungs by the closed-form
     mixed EHL contact scaled to the rung's level on the orbit (below), not by new EHL solves.
-    Returned per position: the means over those cycles of the contact outputs (so Φ̄ is the
-    record's mean loss), tooth forces and velocities, and the DTE's mean over the whole record (its mesh harmonics are the record's). Status 6 (STATUS_ATTRACTOR), or the status kept
+    Returned, as one tuple, per position: the means over those cycles of the contact outputs (so
+    Φ̄ is the record's mean loss), tooth forces and velocities, and the DTE's mean over the whole
+    record (its mesh harmonics are the record's); with them the mesh damper's mean power over the
+    record. Then status 6 (STATUS_ATTRACTOR), or the status kept
     where the record is not finite. Last, the share of the whole record's positions in back-flank
     contact (``SimulationResult.back_contact_share``; the orbit's where the record is not finite)
     and the back flanks' power per position over the same cycles (``_back_flank_power``: sliding,
@@ -743,7 +762,7 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     from .dynamics.model import build_dynamics
     from .dynamics.response import DEFAULT_KICK, record_attractor
 
-    keys = ("forces", "load", "velocity", "dte", "interface", "guess")
+    keys = ("forces", "load", "velocity", "dte", "damper", "interface", "guess")
     operand = (pair, lubricant, surfaces, op, mesh, {k: state[k] for k in keys}, status, warm)
 
     def on_attractor(operand):
@@ -785,11 +804,17 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
             jax.tree_util.tree_map(lambda a: jnp.mean(a, axis=0), per_cycle),
             (jnp.all(per_cycle.converged), jnp.max(per_cycle.failed)),
         )
-        new = (mean, jnp.mean(loads, 0), jnp.mean(speeds, 0), jnp.mean(rec.dynamic_te, 0))
+        new = (
+            mean,
+            jnp.mean(loads, 0),
+            jnp.mean(speeds, 0),
+            jnp.mean(rec.dynamic_te, 0),
+            rec.mesh_damping_power,
+        )
         ok = rec.finite & jnp.all(
             jnp.stack([jnp.all(jnp.isfinite(a)) for a in jax.tree_util.tree_leaves(new)])
         )
-        old = (st["forces"], load, velocity, st["dte"])
+        old = (st["forces"], load, velocity, st["dte"], st["damper"])
         picked = jax.tree_util.tree_map(lambda a, b: jnp.where(ok, a, b), new, old)
         end = jnp.concatenate([rec.final_state, rec.load_torque_correction[None]])
         handover = (jnp.where(ok, end, 0.0), jnp.where(ok, 1.0, 0.0).astype(end.dtype))
@@ -801,13 +826,14 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         back_power = jax.tree_util.tree_map(
             lambda a: jnp.where(ok & jnp.all(jnp.isfinite(a)), a, 0.0), back_power
         )
-        return (*picked, status, handover, back, back_power)
+        return (picked, status, handover, back, back_power)
 
     def keep(operand):
         pair, lubricant, surfaces, op, mesh, st, status, warm = operand
         off = (jnp.zeros_like(warm[0]), jnp.zeros_like(warm[1]))
         back = _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st)
-        return st["forces"], st["load"], st["velocity"], st["dte"], status, off, *back
+        kept = (st["forces"], st["load"], st["velocity"], st["dte"], st["damper"])
+        return kept, status, off, *back
 
     unstable = (state["dynamics_ok"] < 0.5) & jnp.all(jnp.isfinite(state["guess"]))
     # The branch is costly to compile (the dynamics in time): traced once, without the all-members

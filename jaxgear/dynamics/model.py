@@ -58,6 +58,14 @@ backlash function δ(d + ℓ) of the drive side's km(τ) along LOA1 (δ(x) = x �
 x + ℓ below −ℓ): km_b(τ) = km(τ), e_b(τ) = −e(τ) and 2α_w → 0. ``backlash="smooth"`` replaces the
 kinks by softplus corners of width w.
 
+Mesh damping along the line of action (``GearPair.mesh_damping_ratio`` ζ; 0, the paper's model, by
+default): a viscous damper c = 2ζ √(k̄m me) in parallel with each flank pair's spring, on its
+compression rate (d' = ε' − e'(t), d_b' likewise), acting only while the flanks touch and never
+pulling them together: f_d = max(km d + c d', 0) where d > 0 (the back flanks' alike). It is the
+usual linear mesh damping of gear-dynamics models (the squeeze and shear of the film and the
+teeth's material damping lumped), which the paper leaves out; it cushions the impacts of rattling
+teeth. ``backlash="smooth"`` weights the damper by the smoothed contact indicator σ(d/w), unclipped.
+
 Tables (km, e and the mesh-interface sums) are interpolated in time by periodic cubic splines (C²), so the
 right-hand side is smooth between the M table points. The spline interpolates the data as given: a jump
 in the data (a tooth pair entering with load) is reproduced with the usual local spline overshoot.
@@ -255,6 +263,22 @@ class PeriodicSpline(eqx.Module):
             + h2 / 6.0 * ((a**3 - a) * self.second[i] + (s**3 - s) * self.second[j])
         )
 
+    def slope(self, tau, channel: int):
+        """d/dτ of channel ``channel`` at τ (any shape): the spline's exact derivative."""
+        m = self.values.shape[0]
+        u = (tau - jnp.floor(tau)) * m
+        i = jnp.clip(jnp.floor(u).astype(jnp.int32), 0, m - 1)
+        s = u - i
+        j = (i + 1) % m
+        y, second = self.values[:, channel], self.second[:, channel]
+        h2 = 1.0 / m**2
+        a = 1.0 - s
+        return m * (
+            y[j]
+            - y[i]
+            + h2 / 6.0 * ((1.0 - 3.0 * a**2) * second[i] + (3.0 * s**2 - 1.0) * second[j])
+        )
+
 
 # Channels of the interpolated table.
 _KM, _E, _F1, _F1R, _F2, _F2R, _C0, _C1, _C2, _C11, _C12, _C22 = range(12)
@@ -309,6 +333,7 @@ class GearDynamics(eqx.Module):
     back_phase: Float[Array, ""]
     back_angle: Float[Array, ""]
     backlash_width: Float[Array, ""]
+    mesh_damping: Float[Array, ""]
     backlash: str = eqx.field(static=True)
     back_flank: str = eqx.field(static=True)
 
@@ -355,12 +380,53 @@ class GearDynamics(eqx.Module):
         _, d, _, d_b = self._flanks(tau, q)
         return d, d_b
 
-    def flank_forces(self, tau, q, tab=None):
-        """(km⟨d⟩, −km_b⟨d_b⟩) (N) at τ for the displacements ``q`` [..., 6] (m): the drive
-        flanks' normal force (≥ 0, along LOA1) and the back flanks' (≤ 0, along LOA2); their sum
-        is the mesh force Fm whose moment is rb·Fm. ``tab``: the tables at τ, if evaluated."""
+    def flank_rates(self, tau, v):
+        """(dd/dt, dd_b/dt) (m/s): the drive and back flanks' rates of compression at τ for the
+        velocities ``v`` [..., 6] (m/s), the excitations' rates included."""
+        c, s = self.back_direction()
+        de = self.tables.slope(tau, _E) / self.mesh_period
+        if self.back_flank == "same":
+            de_b = -de
+        else:
+            de_b = -self.back_tables.slope(self.back_phase - tau, 1) / self.mesh_period
+        rate = v[..., 0] + v[..., 1] - v[..., 3] - v[..., 4] - de
+        rel = v[..., 0] - v[..., 3] + c * (v[..., 1] - v[..., 4]) - s * (v[..., 2] - v[..., 5])
+        return rate, -rel - de_b
+
+    def _contact_force(self, k, d, rate):
+        """One flank pair's normal force (N, ≥ 0 with exact backlash): k⟨d⟩, plus the mesh damper
+        c·rate while the flanks touch, which pushes them apart and never pulls (the sum is clipped
+        at 0; under the smooth backlash the damper is weighted by the smoothed contact indicator
+        σ(d/w), unclipped)."""
+        elastic = k * self._positive(d)
+        if rate is None:
+            return elastic
+        damper = self.mesh_damping * rate
+        if self.backlash == "exact":
+            return jnp.where(d > 0.0, jnp.maximum(elastic + damper, 0.0), 0.0)
+        return elastic + damper * jax.nn.sigmoid(d / self.backlash_width)
+
+    def flank_forces(self, tau, q, v=None, tab=None):
+        """(f_d, f_b) (N) at τ for the displacements ``q`` [..., 6] (m): the drive flanks' normal
+        force (≥ 0, along LOA1) and the back flanks' (≤ 0, along LOA2); their sum is the mesh
+        force Fm whose moment is rb·Fm. Each is km⟨d⟩ (km_b⟨d_b⟩), with the velocities ``v``
+        [..., 6] (m/s) plus the mesh damper (``GearPair.mesh_damping_ratio``) where the flanks
+        touch (``_contact_force``); without ``v``, the elastic force alone. ``tab``: the tables
+        at τ, if evaluated."""
         km, d, km_b, d_b = self._flanks(tau, q, tab)
-        return km * self._positive(d), -km_b * self._positive(d_b)
+        rate, rate_b = (None, None) if v is None else self.flank_rates(tau, v)
+        return self._contact_force(km, d, rate), -self._contact_force(km_b, d_b, rate_b)
+
+    def damper_power(self, tau, q, v):
+        """Power (W) the mesh damper dissipates at τ for displacements ``q`` and velocities ``v``
+        [..., 6] (SI): (f_d − f_d,el) d' + (f_b,el − f_b) d_b', the damper's part of each flank
+        force (its clipping at 0 included) times that flank pair's compression rate; ≥ 0 with
+        exact backlash."""
+        km, d, km_b, d_b = self._flanks(tau, q)
+        rate, rate_b = self.flank_rates(tau, v)
+        drive = self._contact_force(km, d, rate) - self._contact_force(km, d, None)
+        back = self._contact_force(km_b, d_b, rate_b) - self._contact_force(km_b, d_b, None)
+        return drive * rate + back * rate_b
 
     def load_torque(self, s):
         """T2 (N m) for the correction s."""
@@ -382,7 +448,7 @@ class GearDynamics(eqx.Module):
         rb = self.base_radius
         dphi1 = v[0] / rb[0]
         dphi2 = v[3] / rb[1]
-        f_drive, f_back = self.flank_forces(tau, q, tab)
+        f_drive, f_back = self.flank_forces(tau, q, v, tab)
         fm = f_drive + f_back
         # the back force acts along LOA2: cos 2α_w of it along y, sin 2α_w along x
         c, s_back = self.back_direction()
@@ -434,6 +500,13 @@ def build_dynamics(
     n_steps = jnp.maximum(
         options.steps_per_period, jnp.ceil(options.steps_per_mode_period * f_max * mesh_period)
     )
+    # c = 2ζ √(k̄m me): ζ of the mesh mode of two rotors on a spring k̄m (GearPair docstring)
+    me = pair.blank_inertia / rb**2
+    mesh_damping = (
+        2.0
+        * pair.mesh_damping_ratio
+        * jnp.sqrt(jnp.mean(mesh.mesh_stiffness) * me[0] * me[1] / (me[0] + me[1]))
+    )
     return GearDynamics(
         base_radius=rb,
         inertia=pair.blank_inertia,
@@ -459,6 +532,7 @@ def build_dynamics(
             else jnp.zeros_like(geo.operating_pressure_angle)
         ),
         backlash_width=options.backlash_width,
+        mesh_damping=mesh_damping,
         backlash=options.backlash,
         back_flank=options.back_flank,
     )

@@ -147,6 +147,12 @@ class GearPair(eqx.Module):
         tip_relief: TipRelief (default none).
         bore_radius: (r_int1, r_int2), m, inner radius of the gear body used by the fillet-foundation
             stiffness (default 0.5 × root radius).
+        mesh_damping_ratio: ζ of a viscous mesh damping along the line of action, acting only while
+            a flank pair touches (default 0: the paper's model, whose only mesh damping is the EHL
+            film's along the common tangent). The damping coefficient is c = 2ζ √(k̄m me), k̄m the
+            mean mesh stiffness of the cycle and me = me1 me2/(me1 + me2), mej = Jj/rbj², the
+            mesh mode's equivalent mass; the damper pushes the flanks apart at their rate of
+            compression and never pulls them together. Valid range [0, 1).
     """
 
     teeth: tuple[int, int] = eqx.field(static=True)
@@ -166,6 +172,7 @@ class GearPair(eqx.Module):
     bearings: Bearings
     tip_relief: TipRelief
     bore_radius: Float[Array, "2"]
+    mesh_damping_ratio: Float[Array, ""]
 
     def __init__(
         self,
@@ -187,6 +194,7 @@ class GearPair(eqx.Module):
         bearings: Bearings | None = None,
         tip_relief: TipRelief | None = None,
         bore_radius=None,
+        mesh_damping_ratio=0.0,
     ):
         if len(tuple(teeth)) != 2:
             raise ValueError(f"teeth must be a pair (z1, z2); got {teeth!r}")
@@ -276,6 +284,8 @@ class GearPair(eqx.Module):
         if bore_radius is None:
             bore_radius = 0.5 * self.root_radius
         self.bore_radius = _pair(bore_radius, "bore_radius")
+        check_range("mesh_damping_ratio", mesh_damping_ratio, 0.0, 1.0, high_inclusive=False)
+        self.mesh_damping_ratio = jnp.asarray(mesh_damping_ratio, dtype=float)
 
     def __check_init__(self):
         check_positive("blank_mass", self.blank_mass, "kg")
