@@ -1,6 +1,6 @@
 """A viscous mesh damping along the line of action (``GearPair.mesh_damping_ratio``): the decay
 rate of the linearised mesh mode against the single-degree-of-freedom closed form, a damper that
-pushes touching flanks apart and never pulls them together, nothing at ζ = 0, bad input."""
+acts only while the flanks touch, nothing at ζ = 0, gradients, the dissipated power, bad input."""
 
 from __future__ import annotations
 
@@ -66,7 +66,7 @@ def test_the_mesh_mode_decays_at_the_stated_damping_ratio(zeta):
     assert abs(-mode.real / abs(mode) - zeta) < 1e-6 * zeta
 
 
-def test_the_damper_pushes_touching_flanks_apart_and_never_pulls():
+def test_the_damper_acts_only_while_the_flanks_touch():
     pair = _pair(0.1)
     dyn = _dynamics(pair, e_amp=2e-6, e_harm=2)
     c = float(dyn.mesh_damping)
@@ -88,13 +88,15 @@ def test_the_damper_pushes_touching_flanks_apart_and_never_pulls():
     np.testing.assert_allclose(
         drive(q_in, closing), km * float(d) + c * (0.01 + float(rate)), rtol=1e-12
     )
-    # separating faster than the spring holds them (0.5 µm compressed, km d ≈ 165 N, against the
-    # damper's ≈ 340 N at 0.1 m/s): the force is 0, not a pull
+    # separating faster than the spring relaxes (0.5 µm compressed, km d ≈ 165 N, against the
+    # damper's ≈ 340 N at 0.1 m/s): a Kelvin-Voigt contact pulls (GearDynamics._contact_force)
     e = float(dyn.tables(tau)[1])
     q_light = np.array([e + 0.5e-6, 0, 0, 0, 0, 0])
-    assert km * 0.5e-6 < c * 0.1 - c * abs(float(rate))
-    assert drive(q_light, -10.0 * closing) == 0.0
-    assert drive(q_light, np.zeros(6)) > 0.0
+    rate_sep, _ = dyn.flank_rates(tau, jnp.asarray(-10.0 * closing))
+    np.testing.assert_allclose(
+        drive(q_light, -10.0 * closing), km * 0.5e-6 + c * float(rate_sep), rtol=1e-9
+    )
+    assert drive(q_light, -10.0 * closing) < 0.0
     # apart, moving together: no force before they touch
     q_apart = np.array([-ell, 0, 0, 0, 0, 0])
     assert drive(q_apart, closing) == 0.0
@@ -108,10 +110,10 @@ def test_the_damper_pushes_touching_flanks_apart_and_never_pulls():
     np.testing.assert_allclose(
         back(q_back, -closing), -(km_b * float(d_b) + c * float(rate_b)), rtol=1e-12
     )
+    # apart by 0.5 µm on the back side, closing fast: nothing before they touch
     _, e_b = dyn.back_tables(dyn.back_phase - tau)
-    q_back_light = np.array([-2 * ell - float(e_b) - 0.5e-6, 0, 0, 0, 0, 0])
-    assert back(q_back_light, np.zeros(6)) < 0.0
-    assert back(q_back_light, 10.0 * closing) == 0.0  # opening fast: no pull
+    q_back_apart = np.array([-2 * ell - float(e_b) + 0.5e-6, 0, 0, 0, 0, 0])
+    assert back(q_back_apart, -10.0 * closing) == 0.0
 
 
 def test_the_excitation_rate_is_the_tables_derivative():
@@ -247,3 +249,53 @@ def test_a_damped_sweep_keeps_the_damper_power_apart():
             fidelity=fid,
             mesh_damping_ratio=[1.5],
         )
+
+
+def test_gradients_of_the_orbit_wrt_the_damping_ratio_match_central_differences():
+    # ζ is a traced design variable: the DTE RMS and the damper's power of the periodic orbit
+    # (implicit through the shooting) against central differences; jax.jacfwd of one scalar, the
+    # case a clipped damper force once got wrong (GearDynamics._contact_force). 1e-3 relative:
+    # the central differences' truncation at 2 % steps (~1e-4) and the Newton tolerance (1e-9).
+    base = jg.presets.li2015_pair()
+
+    @eqx.filter_jit
+    def orbit(zeta):
+        pair = eqx.tree_at(lambda p: p.mesh_damping_ratio, base, zeta)
+        res = jg.dynamic_response(pair, jg.OperatingPoint(torque=700.0, speed_rpm=1500.0))
+        return jnp.stack([res.dte_rms, res.mesh_damping_power]), res.converged
+
+    z0, h = jnp.asarray(0.05), 1e-3
+    value, ok = orbit(z0)
+    assert bool(ok)
+    grad = jax.jacfwd(lambda z: orbit(z)[0])(z0)
+    fd = (orbit(z0 + h)[0] - orbit(z0 - h)[0]) / (2 * h)
+    for name, g, f, v in zip(("DTE RMS", "damper power"), grad, fd, value):
+        print(f"d {name}/dζ: implicit {float(g):.6e}, central FD {float(f):.6e}")
+        assert abs(float(f)) * 0.05 > 1e-3 * abs(float(v))  # a real dependence, not noise
+        assert abs(float(g) / float(f) - 1) < 1e-3
+
+
+@pytest.mark.slow
+def test_gradient_of_the_efficiency_wrt_the_damping_ratio_matches_central_differences():
+    # Through the tribo-dynamic fixed point (the regression rung, smooth backlash: the damper
+    # weighted by σ(d/w)). 1e-3 relative: truncation at 2 % steps, fixed point to 1e-10.
+    base = jg.presets.li2015_pair()
+    fid = jg.Fidelity(
+        friction="regression",
+        backlash="smooth",
+        fixed_point_tolerance=1e-10,
+        max_fixed_point_iterations=40,
+    )
+    lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
+    op = jg.OperatingPoint(torque=700.0, speed_rpm=2500.0, inlet_temperature=363.15)
+
+    def efficiency(zeta):
+        pair = eqx.tree_at(lambda p: p.mesh_damping_ratio, base, zeta)
+        return jg.simulate(pair, lub, surf, op, fid).efficiency
+
+    z0, h = jnp.asarray(0.05), 1e-3
+    g = jax.jacfwd(efficiency)(z0)
+    f = (efficiency(z0 + h) - efficiency(z0 - h)) / (2 * h)
+    print(f"dΨ/dζ: implicit {float(g):.6e}, central FD {float(f):.6e}")
+    assert abs(float(f)) > 1e-6  # measured 2.6e-3 per unit ζ: a real dependence
+    assert abs(float(g) / float(f) - 1) < 1e-3

@@ -60,11 +60,12 @@ kinks by softplus corners of width w.
 
 Mesh damping along the line of action (``GearPair.mesh_damping_ratio`` ζ; 0, the paper's model, by
 default): a viscous damper c = 2ζ √(k̄m me) in parallel with each flank pair's spring, on its
-compression rate (d' = ε' − e'(t), d_b' likewise), acting only while the flanks touch and never
-pulling them together: f_d = max(km d + c d', 0) where d > 0 (the back flanks' alike). It is the
+compression rate (d' = ε' − e'(t), d_b' likewise), acting only while the flanks touch: f_d =
+km d + c d' where d > 0 (the back flanks' alike; a Kelvin-Voigt contact, whose damper may pull
+while the flanks separate: see ``_contact_force``). It is the
 usual linear mesh damping of gear-dynamics models (the squeeze and shear of the film and the
 teeth's material damping lumped), which the paper leaves out; it cushions the impacts of rattling
-teeth. ``backlash="smooth"`` weights the damper by the smoothed contact indicator σ(d/w), unclipped.
+teeth. ``backlash="smooth"`` weights the damper by the smoothed contact indicator σ(d/w).
 
 Tables (km, e and the mesh-interface sums) are interpolated in time by periodic cubic splines (C²), so the
 right-hand side is smooth between the M table points. The spline interpolates the data as given: a jump
@@ -394,16 +395,21 @@ class GearDynamics(eqx.Module):
         return rate, -rel - de_b
 
     def _contact_force(self, k, d, rate):
-        """One flank pair's normal force (N, ≥ 0 with exact backlash): k⟨d⟩, plus the mesh damper
-        c·rate while the flanks touch, which pushes them apart and never pulls (the sum is clipped
-        at 0; under the smooth backlash the damper is weighted by the smoothed contact indicator
-        σ(d/w), unclipped)."""
+        """One flank pair's normal force (N): k⟨d⟩, plus the mesh damper c·rate while the flanks
+        touch (d > 0; under the smooth backlash weighted by the smoothed contact indicator
+        σ(d/w)). Nothing acts while they are apart; while they touch the damper pushes them
+        apart as they close and may pull as they separate, as in a Kelvin-Voigt contact."""
         elastic = k * self._positive(d)
         if rate is None:
             return elastic
         damper = self.mesh_damping * rate
         if self.backlash == "exact":
-            return jnp.where(d > 0.0, jnp.maximum(elastic + damper, 0.0), 0.0)
+            # Not clipped at 0 (a Kelvin-Voigt contact: the damper may pull while the flanks
+            # separate faster than the spring relaxes). A clipped force, max(k d + c d', 0), made
+            # jax.jacfwd of one scalar (a vmap of size 1 around the integration loops) wrong even
+            # at ζ = 0 (d DTE/d torque 2.7× off at 1500 rpm, jax 0.10.2, CPU), though every
+            # variant's tangent is the same function; a larger vmap and jax.jvp were right.
+            return jnp.where(d > 0.0, elastic + damper, 0.0)
         return elastic + damper * jax.nn.sigmoid(d / self.backlash_width)
 
     def flank_forces(self, tau, q, v=None, tab=None):

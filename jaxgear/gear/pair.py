@@ -151,8 +151,8 @@ class GearPair(eqx.Module):
             a flank pair touches (default 0: the paper's model, whose only mesh damping is the EHL
             film's along the common tangent). The damping coefficient is c = 2ζ √(k̄m me), k̄m the
             mean mesh stiffness of the cycle and me = me1 me2/(me1 + me2), mej = Jj/rbj², the
-            mesh mode's equivalent mass; the damper pushes the flanks apart at their rate of
-            compression and never pulls them together. Valid range [0, 1).
+            mesh mode's equivalent mass; the damper acts on the flanks' rate of compression while
+            they touch (a Kelvin-Voigt contact). Valid range [0, 1).
     """
 
     teeth: tuple[int, int] = eqx.field(static=True)
