@@ -343,7 +343,8 @@ def _back_contact_share(load):
 
 def _back_flank_power(pair, op, fidelity, mesh, mesh_force, contacts):
     """The back flanks' power loss per position [M] (sliding, rolling), W: the means over the
-    cycles of ``mesh_force`` [C, M] of the back-flank contacts where it is negative.
+    cycles of ``mesh_force`` [C, M] (the back flanks' force, ≤ 0) of the back-flank contacts
+    where it is negative.
 
     The back contacts stand where the mirror image of the drive mesh puts them
     (``gear.mesh.back_flank_mesh``); the negative mesh force is shared among them by their
@@ -518,6 +519,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
             "velocity": u,
             "dte": jnp.where(finite, resp.dynamic_te, state["dte"]),
             "damper": jnp.where(finite, resp.mesh_damping_power, state["damper"]),
+            "back_force": jnp.where(finite, resp.back_force, state["back_force"]),
             "forces": forces,
             "dynamics_ok": jnp.where(finite & (resp.status == 0), 1.0, 0.0),
             "started": jnp.where(finite, 1.0, 0.0) * jnp.ones_like(state["started"]),
@@ -558,6 +560,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         "velocity": velocity0,
         "dte": mesh.static_te,
         "damper": jnp.zeros((), dtype=zeros.dtype),
+        "back_force": jnp.zeros(m, dtype=zeros.dtype),
         "forces": forces0,
         "contacts": jax.lax.stop_gradient(contacts0),
         "dynamics_ok": jnp.asarray(1.0, dtype=zeros.dtype),
@@ -703,15 +706,15 @@ def _record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st):
 
 def _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
     """(back_contact_share, (sliding, rolling) back-flank power per position [M]) of the fixed
-    point's periodic orbit ``st``: its back-flank contacts, where its mesh force (the sum of its
-    tooth forces) is negative, solved as an attractor's (``_record_contacts``,
+    point's periodic orbit ``st``: its back-flank contacts, where the back flanks' force
+    (``DynamicResponse.back_force``) is negative, solved as an attractor's (``_record_contacts``,
     ``_back_flank_power``); zeros where it has none (no periodic orbit of the calibrated pair's
     baseline has any; a light load or a small backlash gives them). A vmap-lazy cond: a sweep
     none of whose points strikes back skips it (run for every member, it cost the 149-speed
     parallel sweep at ``Fidelity.fast()`` 12 %: 40.5 against 36.0 s compiled)."""
     from ._lazy_cond import cond_any_member
 
-    force = jnp.sum(st["load"], axis=-1)[None]  # [1, M]
+    force = st["back_force"][None]  # [1, M]
 
     def strikes(operand):
         pair, lubricant, surfaces, op, mesh, st, force = operand
@@ -725,7 +728,7 @@ def _orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
 
     operand = (pair, lubricant, surfaces, op, mesh, st, force)
     power = cond_any_member(jnp.any(force < 0.0), strikes, none, operand, all_true_path=False)
-    return _back_contact_share(st["load"]), power
+    return jnp.mean((force < 0.0).astype(force.dtype)), power
 
 
 def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status, warm):
@@ -762,7 +765,7 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     from .dynamics.model import build_dynamics
     from .dynamics.response import DEFAULT_KICK, record_attractor
 
-    keys = ("forces", "load", "velocity", "dte", "damper", "interface", "guess")
+    keys = ("forces", "load", "velocity", "dte", "damper", "back_force", "interface", "guess")
     operand = (pair, lubricant, surfaces, op, mesh, {k: state[k] for k in keys}, status, warm)
 
     def on_attractor(operand):
@@ -819,10 +822,9 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
         end = jnp.concatenate([rec.final_state, rec.load_torque_correction[None]])
         handover = (jnp.where(ok, end, 0.0), jnp.where(ok, 1.0, 0.0).astype(end.dtype))
         status = jnp.where(ok, STATUS_ATTRACTOR, status).astype(status.dtype)
-        back = jnp.where(
-            ok, jnp.mean((rec.mesh_force < 0.0).astype(load.dtype)), _back_contact_share(load)
-        )
-        back_power = _back_flank_power(pair, op, fidelity, mesh, rec.mesh_force[pick], each)
+        orbit_share = jnp.mean((st["back_force"] < 0.0).astype(load.dtype))
+        back = jnp.where(ok, jnp.mean((rec.back_force < 0.0).astype(load.dtype)), orbit_share)
+        back_power = _back_flank_power(pair, op, fidelity, mesh, rec.back_force[pick], each)
         back_power = jax.tree_util.tree_map(
             lambda a: jnp.where(ok & jnp.all(jnp.isfinite(a)), a, 0.0), back_power
         )

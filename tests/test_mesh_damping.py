@@ -97,6 +97,9 @@ def test_the_damper_acts_only_while_the_flanks_touch():
         drive(q_light, -10.0 * closing), km * 0.5e-6 + c * float(rate_sep), rtol=1e-9
     )
     assert drive(q_light, -10.0 * closing) < 0.0
+    # that pull is the drive flanks', not a back-flank contact (the back loss and share read the
+    # back flanks' own force, DynamicResponse.back_force)
+    assert back(q_light, -10.0 * closing) == 0.0
     # apart, moving together: no force before they touch
     q_apart = np.array([-ell, 0, 0, 0, 0, 0])
     assert drive(q_apart, closing) == 0.0

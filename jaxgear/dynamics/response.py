@@ -74,6 +74,8 @@ class DynamicResponse(eqx.Module):
         converge, 2 not finite, 3 converged to an unstable orbit; newton_iterations,
         periodicity_residual: max |z(Tm) − z(0)| / max |z| of the returned orbit (dimensionless).
         initial_state: the shooting unknowns [13] (scaled state at τ = 0 and s), reusable as a guess.
+        back_force: the back flanks' force alone (≤ 0, N) [M]: part of ``mesh_force``, apart
+            from a mesh damper's pull on separating drive flanks (``GearDynamics._contact_force``).
         mesh_damping_power: mean power the mesh damper along the line of action dissipates over
             the cycle, W (``GearPair.mesh_damping_ratio``; 0 without it): ⟨(f − f_el) d'⟩ over
             both flank pairs, f_el the elastic force alone, from DAMPER_SAMPLES samples per
@@ -103,6 +105,7 @@ class DynamicResponse(eqx.Module):
     newton_iterations: Int[Array, ""]
     periodicity_residual: Float[Array, ""]
     initial_state: Float[Array, " 13"]
+    back_force: Float[Array, " M"]
     mesh_damping_power: Float[Array, ""]
 
 
@@ -405,7 +408,7 @@ def _kinematics(dyn: GearDynamics, mesh, zs):
     speed = dyn.omega + velocity[..., jnp.array([0, 3])]  # θj' [..., M, gear]
     dx = velocity[..., jnp.array([2, 5])]  # xj' [..., M, gear]
     surf = arms * speed[..., None, :] - dx[..., None, :]
-    return displacement, velocity, dte, (d, d_back), fm, tooth, surf
+    return displacement, velocity, dte, (d, d_back), (fm, f_back), tooth, surf
 
 
 def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) -> DynamicResponse:
@@ -418,7 +421,9 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
     ts = dense[::DAMPER_SAMPLES]
     zs = zs_dense[::DAMPER_SAMPLES]
     resid = jnp.max(jnp.abs(zs[-1] - zs[0])) / jnp.maximum(jnp.max(jnp.abs(zs)), 1e-30)
-    displacement, velocity, dte, (d, d_back), fm, tooth, surf = _kinematics(dyn, mesh, zs[:-1])
+    displacement, velocity, dte, (d, d_back), (fm, f_back), tooth, surf = _kinematics(
+        dyn, mesh, zs[:-1]
+    )
     harm = dte_harmonic_amplitudes(dte)
     rms = jnp.sqrt(jnp.sum(harm**2))
     finite = jnp.all(jnp.isfinite(zs)) & jnp.isfinite(rms)
@@ -455,6 +460,7 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
         newton_iterations=iters.astype(jnp.int32),
         periodicity_residual=resid,
         initial_state=w,
+        back_force=f_back,
         mesh_damping_power=damper,
     )
 
@@ -477,7 +483,8 @@ class AttractorRecord(eqx.Module):
 
     Attributes (SI):
         dynamic_te: εd per recorded cycle and position, m [K, M].
-        mesh_force: km δ, N [K, M]; tooth_force: W_T per pair, N [K, M, 2] (paper Eq. 2);
+        mesh_force: km δ, N [K, M]; back_force: the back flanks' part of it (≤ 0), N [K, M];
+        tooth_force: W_T per pair, N [K, M, 2] (paper Eq. 2);
         surface_velocity: uj per [cycle, position, pair, gear], m/s [K, M, 2, 2] (paper Eq. 3).
         contact_loss: share of the recorded samples with the drive flanks apart (δ ≤ 0).
         dte_harmonics: amplitudes of mesh harmonics 1..10 of the whole record, m [10]; equal to the
@@ -498,6 +505,7 @@ class AttractorRecord(eqx.Module):
 
     dynamic_te: Float[Array, "K M"]
     mesh_force: Float[Array, "K M"]
+    back_force: Float[Array, "K M"]
     tooth_force: Float[Array, "K M 2"]
     surface_velocity: Float[Array, "K M 2 2"]
     contact_loss: Float[Array, ""]
@@ -625,7 +633,7 @@ def record_attractor(
     # mean rigid speed over the record relative to the nominal pitch-line speed rb1 Ω1
     nominal = dyn.base_radius[0] * dyn.omega[0] * dyn.mesh_period / LENGTH_SCALE  # per cycle
     speed_error = drift / (record * nominal)
-    _, _, dte, (d, _), fm, tooth, surf = _kinematics(dyn, mesh, zs)
+    _, _, dte, (d, _), (fm, f_back), tooth, surf = _kinematics(dyn, mesh, zs)
     flat = dte.reshape(-1)
     harm = 2.0 * _safe_abs_complex(jnp.fft.rfft(flat) / flat.shape[0])
     harm = harm[record : record * N_HARMONICS + 1 : record]
@@ -641,6 +649,7 @@ def record_attractor(
     return AttractorRecord(
         dynamic_te=dte,
         mesh_force=fm,
+        back_force=f_back,
         tooth_force=tooth,
         surface_velocity=surf,
         contact_loss=jnp.mean((d < 0.0).astype(dte.dtype)),
