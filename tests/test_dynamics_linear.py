@@ -8,34 +8,9 @@ import math
 import numpy as np
 import pytest
 import scipy.linalg
-from _dynamics_cases import numpy_matrices, synthetic_mesh
+from _dynamics_cases import numpy_matrices, synthetic_mesh, unequal_pair
 
 import jaxgear as jg
-from jaxgear.gear.pair import Bearings
-
-
-def unequal_pair(backlash=0.0, teeth=(40, 61)):
-    """Unequal gears: different blanks and bearings on the two shafts (and 40/61 teeth by default).
-
-    The steady-state tests use 50/50 teeth, as the other dynamics tests do: tooth numbers are static
-    fields, so sharing them shares one compilation of ``dynamic_response`` across the test session;
-    the 40/61 ratio is covered by the eigen-solution test, which needs no compilation."""
-    return jg.GearPair(
-        teeth=teeth,
-        module=3e-3,
-        pressure_angle=math.radians(20.0),
-        face_width=0.02,
-        backlash=backlash,
-        blank_mass=(3.1, 7.4),
-        blank_inertia=(5.2e-3, 2.9e-2),
-        bearings=Bearings(
-            ky=(1.15e9, 0.8e9),
-            cy=(5360.0, 4100.0),
-            kx=(8.0e8, 6.5e8),
-            cx=(2980.0, 2500.0),
-            ct=(10.0, 14.0),
-        ),
-    )
 
 
 def test_natural_frequencies_match_numpy_generalised_eigenproblem():

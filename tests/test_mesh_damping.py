@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from _dynamics_cases import synthetic_mesh
+from _dynamics_cases import synthetic_mesh, unequal_pair
 
 import jaxgear as jg
 from jaxgear.dynamics.model import DynamicsOptions, MeshInterface, build_dynamics
@@ -21,17 +21,8 @@ M = 64
 
 
 def _pair(zeta, bearings=None, backlash=0.14e-3):
-    return jg.GearPair(
-        teeth=(50, 50),
-        module=3e-3,
-        pressure_angle=math.radians(20.0),
-        face_width=0.02,
-        backlash=backlash,
-        blank_mass=(3.1, 7.4),
-        blank_inertia=(5.2e-3, 2.9e-2),
-        bearings=bearings,
-        mesh_damping_ratio=zeta,
-    )
+    """The dynamics tests' unequal gears (50/50 teeth), with the paper's bearings unless given."""
+    return unequal_pair(backlash, (50, 50), bearings or Bearings(), zeta)
 
 
 def _dynamics(pair, km=3.3e8, torque=600.0, speed=2000.0, **mesh_kw):
