@@ -414,7 +414,8 @@ class GearDynamics(eqx.Module):
 
     def flank_forces(self, tau, q, v=None, tab=None):
         """(f_d, f_b) (N) at τ for the displacements ``q`` [..., 6] (m): the drive flanks' normal
-        force (≥ 0, along LOA1) and the back flanks' (≤ 0, along LOA2); their sum is the mesh
+        force (along LOA1; ≥ 0 but for a mesh damper's pull on separating flanks) and the back
+        flanks' (along LOA2; ≤ 0 but for that pull); their sum is the mesh
         force Fm whose moment is rb·Fm. Each is km⟨d⟩ (km_b⟨d_b⟩), with the velocities ``v``
         [..., 6] (m/s) plus the mesh damper (``GearPair.mesh_damping_ratio``) where the flanks
         touch (``_contact_force``); without ``v``, the elastic force alone. ``tab``: the tables
@@ -425,9 +426,8 @@ class GearDynamics(eqx.Module):
 
     def damper_power(self, tau, q, v):
         """Power (W) the mesh damper dissipates at τ for displacements ``q`` and velocities ``v``
-        [..., 6] (SI): (f_d − f_d,el) d' + (f_b,el − f_b) d_b', the damper's part of each flank
-        force (its clipping at 0 included) times that flank pair's compression rate; ≥ 0 with
-        exact backlash."""
+        [..., 6] (SI): the damper's part of each flank pair's force (its magnitude less the elastic
+        force) times that pair's rate of compression: c d'² where the pair touches, ≥ 0."""
         km, d, km_b, d_b = self._flanks(tau, q)
         rate, rate_b = self.flank_rates(tau, v)
         drive = self._contact_force(km, d, rate) - self._contact_force(km, d, None)
