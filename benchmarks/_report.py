@@ -118,3 +118,16 @@ def effective_friction(result) -> float:
     us = result.surface_velocity[..., 0] - result.surface_velocity[..., 1]
     work = float(jnp.mean(jnp.sum(jnp.abs(result.tooth_force * us), axis=1)))
     return float(result.power_loss_sliding) / max(work, 1e-30)
+
+
+def bands(speeds, mask) -> str:
+    """Contiguous runs of ``speeds`` where ``mask`` holds, as "a-b, c, ..."."""
+    runs, start = [], None
+    for i, on in enumerate(list(mask) + [False]):
+        if on and start is None:
+            start = i
+        if not on and start is not None:
+            a, b = speeds[start], speeds[i - 1]
+            runs.append(f"{a:.0f}" if a == b else f"{a:.0f}-{b:.0f}")
+            start = None
+    return ", ".join(runs) or "none"

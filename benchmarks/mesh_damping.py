@@ -26,9 +26,10 @@ jax.config.update("jax_enable_x64", True)
 import equinox as eqx  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
-from _report import machine, write_section  # noqa: E402
+from _report import bands, machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
+from jaxgear.commands.run import _peak as run_peak  # noqa: E402
 from jaxgear.figures import _resonance_dte  # noqa: E402
 
 POINTS = {"A": 1700.0, "B": 1800.0, "C": 2550.0, "D": 3300.0, "E": 3500.0}
@@ -42,26 +43,10 @@ def _sweep(pair, fid, speeds):
     return res, time.perf_counter() - t0
 
 
-def _band(speeds, mask):
-    """'a-b, c-d' runs of consecutive speeds where ``mask``."""
-    if not mask.any():
-        return "none"
-    idx = np.flatnonzero(mask)
-    runs, start = [], idx[0]
-    for a, b in zip(idx[:-1], idx[1:]):
-        if b != a + 1:
-            runs.append((start, a))
-            start = b
-    runs.append((start, idx[-1]))
-    return ", ".join(
-        f"{speeds[a]:.0f}" if a == b else f"{speeds[a]:.0f}-{speeds[b]:.0f}" for a, b in runs
-    )
-
-
 def _peak(speeds, dte, lo, hi):
-    mask = (speeds >= lo) & (speeds <= hi) & np.isfinite(dte)
-    i = int(np.argmax(np.where(mask, dte, -np.inf)))
-    return f"{speeds[i]:.0f} ({1e6 * dte[i]:.1f})"
+    """'rpm (µm)' of the largest DTE in [lo, hi] rpm (``jaxgear run``'s summary peak)."""
+    peak = run_peak(speeds, dte, lo, hi)
+    return "none" if peak is None else f"{peak['speed_rpm']:.0f} ({peak['dte_rms_um']:.1f})"
 
 
 def main(argv=None):
@@ -87,8 +72,8 @@ def main(argv=None):
         resonance = _resonance_dte(res)
         strikes = back > 0
         rows.append(
-            f"| {zeta:g} | {int((status == 6).sum())}: {_band(speeds, status == 6)} | "
-            f"{_band(speeds, strikes)} | {back.max():.2f} | "
+            f"| {zeta:g} | {int((status == 6).sum())}: {bands(speeds, status == 6)} | "
+            f"{bands(speeds, strikes)} | {back.max():.2f} | "
             f"{np.nan_to_num(np.asarray(res.power_loss_back)).max():.1f} | "
             f"{_peak(speeds, resonance, 0, 2600)} | {_peak(speeds, resonance, 2600, 1e9)} | "
             f"{_peak(speeds, dte, 0, 1e9)} | {int(np.sum(np.asarray(res.failed)))} | "

@@ -17,25 +17,12 @@ import jax
 jax.config.update("jax_enable_x64", True)
 
 import numpy as np  # noqa: E402
-from _report import machine, write_section  # noqa: E402
+from _report import bands, machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 
 PAPER_TD = {"A": 257.0, "B": 343.0, "D": 431.0, "E": 948.0}
 PAPER_QS = {"A": 276.0, "B": 302.0, "D": 526.0, "E": 532.0}
-
-
-def _bands(speeds, mask) -> str:
-    """Contiguous runs of ``speeds`` where ``mask`` holds, as "a-b, c, ..."."""
-    runs, start = [], None
-    for i, on in enumerate(list(mask) + [False]):
-        if on and start is None:
-            start = i
-        if not on and start is not None:
-            a, b = speeds[start], speeds[i - 1]
-            runs.append(f"{a:.0f}" if a == b else f"{a:.0f}-{b:.0f}")
-            start = None
-    return ", ".join(runs) or "none"
 
 
 def main(fidelity_name: str = "fast") -> None:
@@ -71,7 +58,7 @@ def main(fidelity_name: str = "fast") -> None:
         f"fidelity {fid}. Sweep wall time (both models, with compilation): {wall:.0f} s. "
         f"Tribo-dynamic points without a stable periodic orbit, reported as means over the "
         f"attractor the gears settle on (status 6): {int(np.sum(td.on_attractor))} "
-        f"({_bands(speeds, td.on_attractor)} rpm). Points not converged: "
+        f"({bands(speeds, td.on_attractor)} rpm). Points not converged: "
         f"{int(np.sum(td.failed))} tribo-dynamic, {int(np.sum(~qs.converged))} quasi-static.",
         "",
         f"R1 DTE-RMS peaks: {speeds[low]:.0f} rpm ({dte[low] * 1e6:.1f} µm) and {speeds[high]:.0f} rpm "

@@ -115,12 +115,6 @@ class DynamicResponse(eqx.Module):
 DAMPER_SAMPLES = 4
 
 
-def damper_power(dyn: GearDynamics, tau, q, v):
-    """Power (W) the mesh damper dissipates at τ for displacements ``q`` and velocities ``v``
-    [..., 6] (SI): ``GearDynamics.damper_power``."""
-    return dyn.damper_power(tau, q, v)
-
-
 def _solver(options: DynamicsOptions):
     return diffrax.Tsit5() if options.solver is None else options.solver
 
@@ -417,7 +411,7 @@ def _postprocess(dyn: GearDynamics, mesh, op, w, aux, options: DynamicsOptions) 
     dense = jnp.arange(DAMPER_SAMPLES * m + 1) / (DAMPER_SAMPLES * m)
     zs_dense = _integrate(dyn, w[:12], w[12], options, ts=dense)
     q_dense, v_dense = dyn.physical(zs_dense[:-1])
-    damper = jnp.mean(damper_power(dyn, dense[:-1], q_dense, v_dense))
+    damper = jnp.mean(dyn.damper_power(dense[:-1], q_dense, v_dense))
     ts = dense[::DAMPER_SAMPLES]
     zs = zs_dense[::DAMPER_SAMPLES]
     resid = jnp.max(jnp.abs(zs[-1] - zs[0])) / jnp.maximum(jnp.max(jnp.abs(zs)), 1e-30)
@@ -616,7 +610,7 @@ def record_attractor(
         z, zs, drift, energy = carry
         t = (i % n_cycle) * h
         q, v = dyn.physical(z)
-        energy = energy + damper_power(dyn, t, q, v)
+        energy = energy + dyn.damper_power(t, q, v)
         z = _rk4_step(dyn, z, s, t, h)
         end = i % n_cycle == n_cycle - 1
         drift = drift + jnp.where(end, 0.5 * (z[0] + z[3]), 0.0)
