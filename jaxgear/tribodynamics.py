@@ -636,6 +636,8 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
     result = _assemble(
         pair, op, mesh, forces, load, velocity, dte, status, residual, its, back, damper
     )
+    if fidelity.attractor_periods > 0:
+        result = _without_derivative_where(result, result.status == STATUS_ATTRACTOR)
     return result, WarmStart(
         interface=state["interface"],
         orbit=state["guess"],
@@ -643,6 +645,39 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         attractor=attractor,
         on_attractor=on_attractor,
     )
+
+
+@jax.custom_jvp
+def _nan_tangent_where(x, flag):
+    """``x``, whose tangent is NaN where ``flag`` (a float, 1 or 0) is 1 and passes unchanged
+    elsewhere: a derivative that does not exist is reported as NaN, not as zero or a part."""
+    del flag
+    return x
+
+
+@_nan_tangent_where.defjvp
+def _nan_tangent_where_jvp(primals, tangents):
+    x, flag = primals
+    tx, _ = tangents
+    scale = jnp.where(flag > 0.5, jnp.nan, 1.0).astype(tx.dtype)
+    return x, scale * tx
+
+
+def _without_derivative_where(result: SimulationResult, flag) -> SimulationResult:
+    """``result`` with every floating-point field's derivative NaN where ``flag`` holds.
+
+    Used at status 6: the attractor's means are not smooth functions of the design (the operand
+    of the attractor branch is cut from the trace), so without this a ``jax.jvp``/``jax.jacfwd``
+    of Ψ there would silently be the part that does not pass through the dynamics (Ψ's T1 ω1, the
+    mesh geometry), neither zero nor the derivative. Values are unchanged."""
+    f = jnp.asarray(flag, dtype=result.power_loss.dtype)
+
+    def mark(leaf):
+        if eqx.is_inexact_array(leaf):
+            return _nan_tangent_where(leaf, f)
+        return leaf
+
+    return jax.tree_util.tree_map(mark, result)
 
 
 def _record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st):
@@ -751,7 +786,8 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     contact (``SimulationResult.back_contact_share``; the orbit's where the record is not finite)
     and the back flanks' power per position over the same cycles (``_back_flank_power``: sliding,
     rolling; zeros where the record is not finite). No derivative passes through the attractor
-    (its means are not smooth functions of the design).
+    (its means are not smooth functions of the design): ``_tribo_dynamic`` makes every derivative
+    of a status-6 result NaN (``_without_derivative_where``).
 
     ``warm``: (state [13], flag) of the previous point's attractor in a continuation sweep; where
     the flag is 1 the record starts from it, with ATTRACTOR_WARM_SETTLE cycles and no kick (the
@@ -904,7 +940,10 @@ def simulate(
 
     Returns:
         SimulationResult; ``converged``/``status`` report failures, never silent NaN. Differentiable in
-        every traced input (forward mode, ``jax.jvp``/``jax.jacfwd``).
+        every traced input (forward mode, ``jax.jvp``/``jax.jacfwd``), except where the result
+        is a mean over an attractor (status 6, no stable periodic orbit): there every derivative
+        is NaN, since the mean over a rattle or a quasi-periodic motion is not a smooth function
+        of the design; the value and its status are still reported.
     """
     fidelity = Fidelity.fast() if fidelity is None else fidelity
     check_inputs(pair, lubricant, surfaces, op, fidelity)

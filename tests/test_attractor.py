@@ -314,6 +314,60 @@ def test_forward_mode_gradient_with_the_attractor_branch_matches_central_differe
     assert float(g[1]) == pytest.approx(float(fd[1]), rel=1e-3)
 
 
+def test_a_mean_over_the_attractor_reports_nan_derivatives_not_a_part_of_them(at_3450):
+    """At status 6 the attractor branch cuts its operand from the trace, so before the marker a
+    ``jax.jvp`` of Ψ there was the part that does not pass through the dynamics (T1 ω1 in Ψ),
+    a finite number that is neither the derivative nor zero. The marker makes every floating
+    field's tangent NaN where the flag holds, leaves it unchanged elsewhere, and leaves the values
+    alone (checked on the real status-6 result's fields; the slow test below runs it through
+    ``simulate``)."""
+    from jaxgear.tribodynamics import _without_derivative_where
+
+    res = at_3450[0]
+    assert int(res.status) == STATUS_ATTRACTOR
+
+    def marked(t, flag):
+        scaled = jax.tree_util.tree_map(lambda a: a * t if eqx.is_inexact_array(a) else a, res)
+        return _without_derivative_where(scaled, flag)
+
+    one = (jnp.asarray(1.0),)
+    values, tangents = jax.jvp(lambda t: marked(t, res.status == STATUS_ATTRACTOR), one, one)
+    _, kept = jax.jvp(lambda t: marked(t, jnp.asarray(False)), one, one)
+    floats = [
+        name for name in type(res).__dataclass_fields__ if eqx.is_inexact_array(getattr(res, name))
+    ]
+    assert "efficiency" in floats and "power_loss" in floats
+    for name in floats:
+        assert bool(jnp.all(getattr(values, name) == getattr(res, name))), name
+        assert bool(jnp.all(jnp.isnan(getattr(tangents, name)))), name
+        # unflagged, the tangent of a · t at t = 1 is a itself, NaN-free where a is
+        assert bool(jnp.array_equal(getattr(kept, name), getattr(res, name))), name
+    assert int(values.status) == STATUS_ATTRACTOR
+
+
+@pytest.mark.slow
+def test_simulate_derivative_is_nan_on_the_attractor_and_finite_on_a_stable_orbit():
+    # end to end: jax.jvp of Ψ in the torque through simulate at 3450 rpm (status 6 at the
+    # default fidelity) is NaN; at 2500 rpm (a stable orbit) it is finite (its value against
+    # central differences: the slow gradient test above). ~3 min, nearly all compilation
+    lub, surf, fid = jg.presets.mil_l_23699(), jg.presets.ground(), jg.Fidelity()
+
+    def eff(torque, rpm):
+        op = jg.OperatingPoint(torque=torque, speed_rpm=rpm, inlet_temperature=363.15)
+        res = jg.simulate(PAIR, lub, surf, op, fid)
+        return res.efficiency, res.status
+
+    for rpm, expect_nan in ((3450.0, True), (2500.0, False)):
+        (value, status), (tangent, _) = jax.jvp(
+            lambda t, rpm=rpm: eff(t, jnp.asarray(rpm)),
+            (jnp.asarray(700.0),),
+            (jnp.asarray(1.0),),
+        )
+        assert bool(jnp.isfinite(value))
+        assert (int(status) == STATUS_ATTRACTOR) == expect_nan, (rpm, int(status))
+        assert bool(jnp.isnan(tangent)) == expect_nan, (rpm, float(tangent))
+
+
 def test_back_flank_strikes_are_counted_from_the_record_not_the_mean_loads(at_3450):
     """Rattling teeth that cross the backlash strike the back flanks (negative tooth forces). The
     share of the cycle they take (``back_contact_share``) and their loss (``power_loss_back``,
