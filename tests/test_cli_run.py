@@ -4,6 +4,9 @@ import json
 import subprocess
 import sys
 
+import matplotlib.image
+import numpy as np
+
 from jaxgear.cli import main
 
 
@@ -22,6 +25,12 @@ def test_run_writes_results_and_resumes(tmp_path, capsys):
     assert main(args) == 0
     for name in ("sweep.csv", "summary.json", "dte_rms.png", "power_loss.png", "efficiency.png"):
         assert (out / name).stat().st_size > 200, name
+    for name in ("dte_rms.png", "power_loss.png", "efficiency.png"):
+        # a real picture, not an empty canvas: it decodes as a PNG, and its pixels are not all
+        # one colour (the axes, labels and curves)
+        image = matplotlib.image.imread(out / name)
+        assert image.ndim == 3 and image.shape[0] > 200 and image.shape[1] > 200, name
+        assert float(np.ptp(image[..., :3])) > 0.5, name
     summary = json.loads((out / "summary.json").read_text())
     head = summary["headline"]
     assert head["speeds_rpm"] == [1000.0, 1500.0, 2]
