@@ -22,7 +22,12 @@ Numerics:
   as converged when |g_p| ≤ ``gtol`` · |g_p at the start|.
 - **Non-converged simulations are never used.** The objective returns, beside its value, whether every
   simulate point converged. A step that lands on a non-converged point is rejected and the run stops,
-  returning the best converged point with status ``STATUS_SIMULATION``.
+  returning the best converged point with status ``STATUS_SIMULATION``. A speed without a stable
+  periodic orbit (``simulate``'s status 6, a mean over the attractor) counts as not converged: the
+  mean over a rattle is not a smooth function of the design, and its derivatives are NaN. So an
+  optimisation over a speed range that crosses an instability band (the calibrated pair's
+  775-825, 1925-1975, 3375-3550 and 3750-4050 rpm at ``Fidelity.fast()``) stops at its start;
+  choose speeds with a stable orbit, or add mesh damping (``GearPair.mesh_damping_ratio``).
 """
 
 from __future__ import annotations
