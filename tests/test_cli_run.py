@@ -35,8 +35,10 @@ def test_run_writes_results_and_resumes(tmp_path, capsys):
     head = summary["headline"]
     assert head["speeds_rpm"] == [1000.0, 1500.0, 2]
     assert head["points_not_converged"] == 0
-    # REFERENCE §7 R4: efficiency within 99.6-99.85 % at the paper's conditions (the formula rung
-    # gives the sliding loss only, so it sits at the upper edge of the band or slightly above).
+    # REFERENCE §7 R4: efficiency within 99.6-99.85 % at the paper's conditions. Not the band
+    # itself: Fidelity.fast() shares the paper fidelity's loss level, 0.3-0.6 of the paper's, so
+    # its Ψ sits at the band's upper edge or just above (99.84-99.91 % over the baseline sweep,
+    # README); 99.95 % catches a loss level off by another factor of 2, not the known gap.
     assert 99.6 < head["mean_efficiency_percent"] < 99.95
     rows = (out / "sweep.csv").read_text().splitlines()
     assert rows[0].startswith("speed_rpm,power_loss_W") and len(rows) == 3
