@@ -189,6 +189,50 @@ def test_coupled_rung_consistency_and_fast_preset():
     assert float(qs.power_loss) == pytest.approx(total / 32, rel=1e-9)
 
 
+# REFERENCE §7 R3 around the lower resonance and below the higher one, at the fast preset (this
+# rung; within 6.1 % of Fidelity.paper()'s Φ̄ over the baseline sweep, benchmarks/fast_vs_paper.py):
+# the tribo-dynamic loss lower than the quasi-static one at A and D, higher at B (the paper 257
+# against 276 W at A, 343 against 302 W at B, 431 against 526 W at D). The calibrated pair's DTE
+# peaks sit at 1750 and 3375 rpm, so A 1700, B 1800, D 3325 rpm, as `jaxgear figures` places them
+# on the paper's 25 rpm grid; all three have a stable periodic orbit (status 0), so these are
+# orbits, not attractor means. The reference is what the dynamics did not produce: the same
+# contacts at the static loads and kinematic velocities. Measured (2026-11-25, again 2026-12-01):
+# A −3.30 %, B +3.96 %, D −12.24 % (the paper fidelity −4.1, +3.4, −12.1 %, docs/figures/paper).
+# Point E (the paper +78 %) is not reproduced at this preset (README); it is tested at the
+# calibrated one (tests/test_paper_calibrated.py, slow). Same inputs as the test above, so the
+# compiled simulate is reused when both run in one process.
+R3_POINTS = {"A": 1700.0, "B": 1800.0, "D": 3325.0}
+
+
+@pytest.fixture(scope="module")
+def r3_ratios():
+    pair = jg.presets.li2015_pair_calibrated()
+    ratios = {}
+    for name, rpm in R3_POINTS.items():
+        op = jg.OperatingPoint(torque=700.0, speed_rpm=rpm, inlet_temperature=363.15)
+        td = jg.simulate(pair, LUB, GROUND, op, jg.Fidelity.fast())
+        qs = jg.simulate(pair, LUB, GROUND, op, jg.Fidelity.fast(dynamics="quasi_static"))
+        assert int(td.status) == 0 and int(qs.status) == 0, (name, int(td.status))
+        ratios[name] = float(td.power_loss) / float(qs.power_loss)
+    return ratios
+
+
+# Margins: the signs of R3 with room for the fixed point's tolerance (tables to 1e-4 of their
+# largest entry) and for the rung's few-percent difference from the paper fidelity, whose ratios
+# at A, B, D are within 0.8 points of these; not the paper's magnitudes (A −7 %, B +14 %, D −18 %),
+# which the model does not claim at these points.
+def test_r3_tribo_dynamic_loss_below_quasi_static_at_a(r3_ratios):
+    assert r3_ratios["A"] < 0.99, r3_ratios
+
+
+def test_r3_tribo_dynamic_loss_above_quasi_static_at_b(r3_ratios):
+    assert r3_ratios["B"] > 1.01, r3_ratios
+
+
+def test_r3_tribo_dynamic_loss_well_below_quasi_static_at_d(r3_ratios):
+    assert r3_ratios["D"] < 0.95, r3_ratios
+
+
 def test_slivers_of_load_at_the_relief_edge_carry_nothing():
     # Tip relief can leave a slot with a load like 1e-289 N (10 N m, 50 µm relief: found by the
     # extremes matrix). The closed forms have no meaning there (unbounded film, 0/0 in the asperity
