@@ -1,8 +1,16 @@
 import jax
 import pytest
 
+from jaxgear.cli import enable_compilation_cache
+
 # Tests run in float64 (EHL needs it); the library never flips this itself.
 jax.config.update("jax_enable_x64", True)
+# Compiled programs on disk from the first test on, as `jaxgear` keeps them ($JAXGEAR_CACHE_DIR,
+# default ~/.cache/jaxgear/xla; "off" disables). The suite compiles the same programs in many
+# modules (each module's in-memory programs are dropped when it ends, below). Before, only the
+# in-process `jaxgear run` test switched the cache on, halfway through one worker's share: a run
+# then took 30 min with an empty cache and 17 min with the one the previous run had left.
+enable_compilation_cache()
 
 
 @pytest.fixture(autouse=True, scope="module")
