@@ -109,3 +109,23 @@ def held_passage(model, contact, lub, surfaces, dt, k):
 
     contacts = jax.tree_util.tree_map(lambda a: jnp.full((k,), a), contact)
     return solve_ehl_passage(contacts, lub, model, surfaces, times=jnp.arange(k) * dt)
+
+
+def greenwood_tripp_constant(density_product, slope_ratio):
+    """Greenwood-Tripp K′ = (8√2/15) π (nβσ)² √(σ/β) (Johnson, Greenwood & Poon 1972), coded here
+    apart from the library's ``asperity.asperity_constant`` as the tests' reference."""
+    return 8.0 * math.sqrt(2.0) / 15.0 * math.pi * density_product**2 * math.sqrt(slope_ratio)
+
+
+def greenwood_tripp_pressure(h, sigma, e_reduced, density_product, slope_ratio):
+    """Greenwood-Tripp asperity pressure K′ E′ F_{5/2}(h/σ) at the films ``h`` (m), Pa, with
+    F_{5/2}(λ) = (2π)^(−½) ∫_λ^∞ (s − λ)^{5/2} exp(−s²/2) ds by adaptive quadrature: the tests'
+    reference for the library's ``asperity.asperity_pressure``."""
+    from scipy.integrate import quad
+
+    def f52(lam):
+        value, _ = quad(lambda s: (s - lam) ** 2.5 * math.exp(-0.5 * s * s), lam, lam + 40.0)
+        return value / math.sqrt(2.0 * math.pi)
+
+    k = greenwood_tripp_constant(density_product, slope_ratio)
+    return np.array([k * e_reduced * f52(float(v) / sigma) for v in np.ravel(np.asarray(h))])

@@ -8,14 +8,12 @@ Contacts are the paper's pitch-point contact from ``ehl_cases``; roughness the s
 compilation (~25 s of CPU each), so the default run compiles one; the monotone sweep is ``slow``.
 """
 
-import math
 import re
 import tomllib
 
 import numpy as np
 import pytest
-from ehl_cases import gear_contact
-from scipy.integrate import quad
+from ehl_cases import gear_contact, greenwood_tripp_pressure
 
 import jaxgear as jg
 from jaxgear.config import fidelity_from_config, sweep_from_config
@@ -35,23 +33,6 @@ n_positions = 24
 asperity_density_product = 0.08
 asperity_slope_ratio = 0.05
 """
-
-
-def _k_prime(density_product, slope_ratio):
-    """Greenwood-Tripp K′ = (8√2/15) π (nβσ)² √(σ/β) (Johnson, Greenwood & Poon 1972)."""
-    return 8.0 * math.sqrt(2.0) / 15.0 * math.pi * density_product**2 * math.sqrt(slope_ratio)
-
-
-def _f52(lam):
-    """F_{5/2}(λ) = (2π)^(−½) ∫_λ^∞ (s − λ)^{5/2} exp(−s²/2) ds, by adaptive quadrature."""
-    value, _ = quad(lambda s: (s - lam) ** 2.5 * math.exp(-0.5 * s * s), lam, lam + 40.0)
-    return value / math.sqrt(2.0 * math.pi)
-
-
-def _asperity_pressure(h, sigma, e_reduced, density_product, slope_ratio):
-    """Greenwood-Tripp asperity pressure K′ E′ F_{5/2}(h/σ) at the films ``h``, Pa."""
-    k = _k_prime(density_product, slope_ratio)
-    return np.array([k * e_reduced * _f52(float(v) / sigma) for v in np.asarray(h)])
 
 
 @pytest.fixture(scope="module")
@@ -134,8 +115,8 @@ def test_deep_mixed_asperity_pressure_is_greenwood_tripp_of_the_given_parameters
     assert bool(sol.converged), float(sol.residual)
     ph = float(sol.hertz_pressure)
     sigma, e_red = float(surf.composite_rq), float(c.e_reduced)
-    given = _asperity_pressure(sol.h, sigma, e_red, 0.08, 0.05)
-    default = _asperity_pressure(sol.h, sigma, e_red, 0.05, 0.01)
+    given = greenwood_tripp_pressure(sol.h, sigma, e_red, 0.08, 0.05)
+    default = greenwood_tripp_pressure(sol.h, sigma, e_red, 0.05, 0.01)
     carried = np.asarray(sol.asperity_pressure)
     # a deep mixed contact: asperities carry a large share of the load (measured 0.47)
     assert float(sol.contact_load_share) > 0.2
@@ -163,7 +144,7 @@ def test_thick_film_parameters_change_nothing(toml_model):
     # (μ_fluid ≈ 0.005 × the load (π/2) ph b) by < (4/π)(μb/μ_fluid)(p_a/ph) ≈ 3e-5 relative;
     # rtol 1e-4 allows for that. (The solver's outer iteration drops asperity pressures below
     # 1e-3 ph altogether, so in practice the two solutions are identical.)
-    pa_max = _asperity_pressure([rough.h_min], sigma, float(c.e_reduced), 0.08, 0.05)[0]
+    pa_max = greenwood_tripp_pressure([rough.h_min], sigma, float(c.e_reduced), 0.08, 0.05)[0]
     assert pa_max < 1e-6 * float(rough.hertz_pressure)
     assert float(rough.contact_load_share) < 1e-5
     for name in ("friction_sliding", "power_loss_sliding", "power_loss_rolling", "h_central"):

@@ -10,13 +10,11 @@ Fr (u1 + u2) = ur ∫ h dp (the continuum identity of the Poiseuille heat, deriv
 tests/test_mixed_thermal.py (REFERENCE §2-§3, §6).
 """
 
-import math
-
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact
+from ehl_cases import gear_contact, greenwood_tripp_pressure
 from scipy import integrate
 
 import jaxgear as jg
@@ -80,24 +78,6 @@ def _rolling_work(f):
     xf, flux = _mass_flux(f)
     q = np.median(flux[np.abs(xf) < 0.5 * f["b"]])
     return ur * h_dp - q * g_outlet, ur * h_dp
-
-
-def _gt_pressure(lam, model, e_reduced):
-    """Greenwood-Tripp asperity pressure K′E′F_{5/2}(λ), Pa, coded here by adaptive quadrature."""
-    k = (
-        8.0
-        * math.sqrt(2.0)
-        / 15.0
-        * math.pi
-        * model.asperity_density_product**2
-        * math.sqrt(model.asperity_slope_ratio)
-    )
-
-    def f52(v):
-        val, _ = integrate.quad(lambda s: (s - v) ** 2.5 * math.exp(-0.5 * s * s), v, np.inf)
-        return val / math.sqrt(2.0 * math.pi)
-
-    return np.array([k * e_reduced * f52(v) for v in lam])
 
 
 @pytest.fixture(scope="module")
@@ -164,7 +144,13 @@ def test_statistical_thermal_heat_equals_friction_work(statistical_film):
     # iteration stops when the two agree within 1e-3 ph (measured 0.94e-3 ph; the GT quadratures
     # agree to ~1e-9, so the bound is that criterion's, 1.1e-3 ph)
     hertz = np.abs(x) < b
-    expected = _gt_pressure(f["h"][hertz] / float(surf.composite_rq), STAT_THERMAL, c.e_reduced)
+    expected = greenwood_tripp_pressure(
+        f["h"][hertz],
+        float(surf.composite_rq),
+        float(c.e_reduced),
+        STAT_THERMAL.asperity_density_product,
+        STAT_THERMAL.asperity_slope_ratio,
+    )
     gap = np.max(np.abs(np.asarray(sol.asperity_pressure)[hertz] - expected))
     assert gap < 1.1e-3 * float(sol.hertz_pressure), gap / float(sol.hertz_pressure)
 

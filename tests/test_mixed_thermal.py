@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import bump_surfaces, gear_contact, held_passage
+from ehl_cases import bump_surfaces, gear_contact, greenwood_tripp_constant, held_passage
 
 import jaxgear as jg
 from jaxgear.lubrication import asperity
@@ -514,12 +514,10 @@ def test_extremes_are_finite(rpm, slide, scale):
         lam = np.asarray(sol.h)[hertz] / float(surf.composite_rq)
         assert float(np.max(lam)) < 0.05
         f52_0 = 2**0.75 * math.gamma(1.75) / math.sqrt(2 * math.pi)
-        p_a0 = (
-            (8 * math.sqrt(2) / 15 * math.pi * STAT_THERMAL.asperity_density_product**2)
-            * math.sqrt(STAT_THERMAL.asperity_slope_ratio)
-            * float(c.e_reduced)
-            * f52_0
+        k_prime = greenwood_tripp_constant(
+            STAT_THERMAL.asperity_density_product, STAT_THERMAL.asperity_slope_ratio
         )
+        p_a0 = k_prime * float(c.e_reduced) * f52_0
         saturated = 2.0 * float(sol.hertz_half_width) * p_a0 / float(c.load_per_width)
         assert float(sol.contact_load_share) > 0.9 * saturated, (
             float(sol.contact_load_share),

@@ -4,7 +4,6 @@ low-speed limit), statuses, and gradients."""
 
 import math
 
-import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -12,6 +11,7 @@ import pytest
 
 import jaxgear as jg
 from jaxgear.fidelity import Fidelity
+from jaxgear.optimise import with_tip_relief
 from jaxgear.tribodynamics import simulate
 
 
@@ -156,11 +156,7 @@ def test_gradient_tribo_dynamic_wrt_relief_amount_and_start(setup):
     base = jg.presets.li2015_pair()
 
     def eff(x):
-        p = eqx.tree_at(
-            lambda q: (q.tip_relief.amount, q.tip_relief.start_roll_angle),
-            base,
-            (jnp.full(2, x[0]), jnp.full(2, x[1])),
-        )
+        p = with_tip_relief(base, x, both_gears=True)  # as optimise_tip_relief substitutes them
         op = jg.OperatingPoint(torque=700.0, speed_rpm=2500.0)
         return simulate(p, lub, surf, op, fid).efficiency
 
