@@ -25,7 +25,8 @@ from ._krylov import EarlyExitGMRES
 from ._validation import check_instance, check_non_negative, is_concrete
 from .anderson import Anderson
 from .dynamics.model import DynamicsOptions, MeshInterface
-from .dynamics.response import dte_harmonic_amplitudes, dynamic_response
+from .dynamics.attractor import DEFAULT_KICK, record_attractor
+from .dynamics.response import dte_harmonic_amplitudes, steady_state
 from .fidelity import Fidelity
 from .gear.geometry import gear_geometry, mesh_period
 from .gear.load_sharing import DEFAULT_CONTACT_SMOOTHING
@@ -469,9 +470,7 @@ def _tribo_dynamic(pair, lubricant, surfaces, op, fidelity, mesh, warm):
         )
 
     def respond(interface, guess):
-        return dynamic_response(
-            pair, op, mesh=mesh, interface=interface, options=options, initial_state=guess
-        )
+        return steady_state(pair, op, mesh, interface, options, guess)
 
     # Plain iteration damps inside the map; Anderson damps in its mixing (same fixed point).
     beta = fidelity.relaxation if fidelity.anderson_memory == 0 else 1.0
@@ -799,7 +798,6 @@ def _attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, statu
     (``cond_any_member(..., mixed="map")``)."""
     from ._lazy_cond import cond_any_member
     from .dynamics.model import build_dynamics
-    from .dynamics.response import DEFAULT_KICK, record_attractor
 
     keys = ("forces", "load", "velocity", "dte", "damper", "back_force", "interface", "guess")
     operand = (pair, lubricant, surfaces, op, mesh, {k: state[k] for k in keys}, status, warm)

@@ -448,13 +448,27 @@ class GearDynamics(eqx.Module):
         """r1φ1 + y1 − r2φ2 − y2 − e (m): εd for e = 0, the drive flanks' compression for e(τ)."""
         return q[..., 0] + q[..., 1] - q[..., 3] - q[..., 4] - e
 
+    def _forces_and_damper_power(self, tau, q, v, tab):
+        """(f_d, f_b, P): ``flank_forces`` with the velocities, and ``damper_power``, from one
+        evaluation of the flanks' compressions and rates at τ (``tab``: the tables at τ)."""
+        km, d, km_b, d_b = self._flanks(tau, q, tab)
+        rate, rate_b = self.flank_rates(tau, v)
+        elastic, elastic_b = self._contact_force(km, d, None), self._contact_force(km_b, d_b, None)
+        drive, back = self._contact_force(km, d, rate), self._contact_force(km_b, d_b, rate_b)
+        power = (drive - elastic) * rate + (back - elastic_b) * rate_b
+        return drive, -back, power
+
     def accelerations(self, tau, q, v, s):
         """d²q/dt² (m/s²) of paper Eq. (1) at time fraction τ."""
+        return self._accelerations_and_damper_power(tau, q, v, s)[0]
+
+    def _accelerations_and_damper_power(self, tau, q, v, s):
+        """(d²q/dt² in m/s², the mesh damper's power in W) at time fraction τ."""
         tab = self.tables(tau)
         rb = self.base_radius
         dphi1 = v[0] / rb[0]
         dphi2 = v[3] / rb[1]
-        f_drive, f_back = self.flank_forces(tau, q, v, tab)
+        f_drive, f_back, power = self._forces_and_damper_power(tau, q, v, tab)
         fm = f_drive + f_back
         # the back force acts along LOA2: cos 2α_w of it along y, sin 2α_w along x
         c, s_back = self.back_direction()
@@ -474,12 +488,17 @@ class GearDynamics(eqx.Module):
         ddphi2 = (-t2 - tab[_F2R] - fd_r2 - self.ct[1] * dphi2 + rb[1] * fm) / j[1]
         ddy2 = (-self.cy[1] * v[4] - self.ky[1] * q[4] + fy) / m[1]
         ddx2 = (-self.cx[1] * v[5] - self.kx[1] * q[5] + (tab[_F2] + fd) - fx) / m[1]
-        return jnp.stack([rb[0] * ddphi1, ddy1, ddx1, rb[1] * ddphi2, ddy2, ddx2])
+        return jnp.stack([rb[0] * ddphi1, ddy1, ddx1, rb[1] * ddphi2, ddy2, ddx2]), power
 
     def __call__(self, tau, z, s):
+        return self.rate_and_damper_power(tau, z, s)[0]
+
+    def rate_and_damper_power(self, tau, z, s):
+        """(dz/dτ of the scaled state [12], the mesh damper's power in W) at time fraction τ:
+        the vector field, and the integrand of the damper's mean power ∫₀¹ P dτ."""
         q, v = self.physical(z)
-        a = self.accelerations(tau, q, v, s)
-        return jnp.concatenate([z[6:], a * (self.mesh_period**2 / LENGTH_SCALE)])
+        a, power = self._accelerations_and_damper_power(tau, q, v, s)
+        return jnp.concatenate([z[6:], a * (self.mesh_period**2 / LENGTH_SCALE)]), power
 
 
 def build_dynamics(

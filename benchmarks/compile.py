@@ -1,0 +1,168 @@
+"""What compilation costs a user, old code against new, side by side in one run.
+
+For each source tree (this checkout, and the code before the differentiable-core change checked out
+beside it with ``git worktree add ../old 83eda1e``), a fresh process with the on-disk compilation
+cache off measures, at ``Fidelity.fast()`` on the calibrated pair (ground, 700 N m, 90 °C,
+2500 rpm):
+
+- ``simulate``: tracing (``jax.jit(...).trace``), lowering and XLA compilation apart, the lowered
+  program's size (StableHLO lines and ``while`` loops), and the run (median of 5, compiled);
+- the reverse gradient of Ψ with respect to the whole float part of (pair, operating point,
+  fidelity) with ``eqx.filter_value_and_grad``: the same four figures (where the tree supports it);
+- ``jaxgear run`` cold (a fresh process, compilation cache off): wall time.
+
+Writes the section ``compile`` of benchmarks/RESULTS.md. Run from the repository root:
+    python benchmarks/compile.py [--old ../old] [--skip-run]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+PROBE = r"""
+import json, statistics, sys, time
+import jax
+jax.config.update("jax_enable_x64", True)
+import equinox as eqx
+import jax.numpy as jnp
+import jaxgear as jg
+
+out = {"jaxgear": jg.__file__}
+pair = jg.presets.li2015_pair_calibrated()
+lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
+op = jg.OperatingPoint(torque=700.0, speed_rpm=2500.0, inlet_temperature=363.15)
+fid = jg.Fidelity.fast()
+
+
+def stages(fn, *args):
+    t0 = time.perf_counter(); traced = jax.jit(fn).trace(*args); t1 = time.perf_counter()
+    lowered = traced.lower(); t2 = time.perf_counter()
+    compiled = lowered.compile(); t3 = time.perf_counter()
+    text = lowered.as_text()
+    res = compiled(*args); jax.block_until_ready(res)
+    runs = []
+    for _ in range(5):
+        t = time.perf_counter(); jax.block_until_ready(compiled(*args)); runs.append(time.perf_counter() - t)
+    return {
+        "trace_s": t1 - t0, "lower_s": t2 - t1, "compile_s": t3 - t2,
+        "hlo_lines": text.count("\n"), "hlo_while": text.count("stablehlo.while"),
+        "run_s": statistics.median(runs),
+    }, res
+
+
+def forward(pair, op):
+    return jg.simulate(pair, lub, surf, op, fidelity=fid).efficiency
+
+
+out["simulate"], eff = stages(forward, pair, op)
+out["efficiency"] = float(eff)
+
+params, static = eqx.partition((pair, op), eqx.is_inexact_array)
+if hasattr(fid, "with_constants"):
+    fparams, fstatic = eqx.partition(fid, eqx.is_inexact_array)
+else:
+    fparams, fstatic = None, fid
+
+
+def objective(params, fparams):
+    p, o = eqx.combine(params, static)
+    f = fstatic if fparams is None else eqx.combine(fparams, fstatic)
+    return jg.simulate(p, lub, surf, o, fidelity=f).efficiency
+
+
+try:
+    out["gradient"], (val, grads) = stages(jax.value_and_grad(objective, argnums=(0, 1)), params, fparams)
+    leaves = jax.tree_util.tree_leaves(grads)
+    out["gradient"]["finite"] = bool(all(bool(jnp.all(jnp.isfinite(g))) for g in leaves))
+    out["gradient"]["entries"] = int(sum(g.size for g in leaves))
+except Exception as exc:  # the old tree: reverse mode fails
+    out["gradient"] = {"error": f"{type(exc).__name__}: {str(exc).splitlines()[0][:200]}"}
+print("RESULT " + json.dumps(out))
+"""
+
+
+def probe(root: Path) -> dict:
+    env = {
+        **os.environ,
+        "PYTHONPATH": str(root),
+        "JAXGEAR_CACHE_DIR": "off",
+        "JAX_COMPILATION_CACHE_DIR": "",
+    }
+    proc = subprocess.run(
+        [sys.executable, "-c", PROBE], cwd=root, env=env, capture_output=True, text=True
+    )
+    for line in proc.stdout.splitlines():
+        if line.startswith("RESULT "):
+            return json.loads(line[7:])
+    raise RuntimeError(f"probe in {root} failed:\n{proc.stderr[-3000:]}")
+
+
+def jaxgear_run(root: Path) -> float:
+    exe = Path(sys.executable).with_name("jaxgear")
+    with tempfile.TemporaryDirectory() as out:
+        env = {**os.environ, "PYTHONPATH": str(root), "JAXGEAR_CACHE_DIR": "off"}
+        env["MPLBACKEND"] = "Agg"
+        t0 = time.perf_counter()
+        subprocess.run(
+            [str(exe), "run", "--out", out], check=True, env=env, cwd=root, capture_output=True
+        )
+        return time.perf_counter() - t0
+
+
+def _row(label, r):
+    if "error" in r:
+        return f"| {label} | {r['error']} | | | | | |"
+    return (
+        f"| {label} | {r['trace_s']:.1f} | {r['lower_s']:.1f} | {r['compile_s']:.1f} | "
+        f"{r['hlo_lines']:,} ({r['hlo_while']}) | {r['run_s'] * 1e3:.0f} | "
+    )
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--old", type=Path, default=ROOT.parent / "old")
+    parser.add_argument("--skip-run", action="store_true", help="skip the jaxgear run timing")
+    args = parser.parse_args()
+    sys.path.insert(0, str(Path(__file__).parent))
+    from _report import machine, write_section
+
+    trees = {"before (83eda1e)": args.old.resolve(), "now": ROOT}
+    results = {name: probe(root) for name, root in trees.items()}
+    if not args.skip_run:
+        for name, root in trees.items():
+            results[name]["jaxgear_run_s"] = jaxgear_run(root)
+    lines = [
+        f"Machine: {machine()}. `Fidelity.fast()`, calibrated pair, ground, 700 N m, 2500 rpm; "
+        "compilation cache off, each tree in a fresh process, both in this run.",
+        "",
+        "| program | trace s | lower s | XLA compile s | StableHLO lines (while loops) | run ms |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, r in results.items():
+        lines.append(_row(f"simulate, {name}", r["simulate"]))
+        lines.append(_row(f"reverse gradient, {name}", r["gradient"]))
+    if not args.skip_run:
+        lines += ["", "| `jaxgear run` cold | s |", "|---|---|"]
+        lines += [f"| {name} | {r['jaxgear_run_s']:.0f} |" for name, r in results.items()]
+    grad = results["now"]["gradient"]
+    if "error" not in grad:
+        lines += [
+            "",
+            f"Reverse gradient: {grad['entries']} entries, all finite: {grad['finite']}.",
+        ]
+    print("\n".join(lines))
+    print(json.dumps(results, indent=1))
+    write_section("compile", "\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
