@@ -37,18 +37,18 @@ import numpy as np  # noqa: E402
 from _report import machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
+from jaxgear.contact import formula_ehl_contact_forces  # noqa: E402
+from jaxgear.dynamics.attractor import DEFAULT_KICK, record_attractor  # noqa: E402
 from jaxgear.dynamics.model import build_dynamics  # noqa: E402
-from jaxgear.dynamics.response import DEFAULT_KICK, record_attractor  # noqa: E402
 from jaxgear.gear.mesh import mesh_cycle  # noqa: E402
 from jaxgear.lubrication.ehl_formula import ehl_formula_contact  # noqa: E402
 from jaxgear.material import reduced_modulus  # noqa: E402
 from jaxgear.tribodynamics import (  # noqa: E402
     ATTRACTOR_CONTACT_CYCLES,
     STATUS_ATTRACTOR,
-    _dynamics_options,
-    formula_ehl_contact_forces,
     simulate_with_state,
 )
+from jaxgear.tribodynamics.fixed_point import dynamics_options  # noqa: E402
 
 PAIR = jg.presets.li2015_pair_calibrated()
 LUB, SURF = jg.presets.mil_l_23699(), jg.presets.ground()
@@ -98,7 +98,7 @@ def _attractor_cycles(op, mesh, warm):
     """Tooth forces and velocities [K, M, 2(, 2)] of the K cycles whose contacts make the means of a
     status-6 point: the record ``simulate`` took (rebuilt from its WarmStart, as in
     tests/test_attractor.py: a cold single point starts from the unstable orbit with the kick)."""
-    options = _dynamics_options(FID)
+    options = dynamics_options(FID)
     dyn = build_dynamics(PAIR, op, mesh, warm.interface, options)
     rec = record_attractor(
         dyn, mesh, warm.orbit, options, FID.settle_periods, FID.attractor_periods, DEFAULT_KICK

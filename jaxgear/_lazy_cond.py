@@ -4,7 +4,7 @@ A vmapped ``lax.cond`` with a batched predicate becomes a select: both branches 
 member. That made a vmapped batch of EHL contacts pay for every fallback attempt of the solver
 (benchmarks/ehl_kernel.py), and would make every point of a vmapped speed sweep pay for the
 attractor integration that only the points without a stable periodic orbit need
-(``tribodynamics._attractor_means``).
+(``tribodynamics.second_pass.attractor_means``).
 """
 
 from __future__ import annotations

@@ -122,9 +122,9 @@ class Fidelity(eqx.Module):
             result is then the mean over this many mesh cycles of that attractor, reached by time
             integration with the last interface tables (``jaxgear.dynamics.attractor_response``),
             with the contacts evaluated at every position of 64 cycles spread over the record
-            (tribodynamics.ATTRACTOR_CONTACT_CYCLES; status 6,
+            (tribodynamics.second_pass.ATTRACTOR_CONTACT_CYCLES; status 6,
             "attractor"; on the EHL rungs through the closed-form mixed EHL contact scaled to the
-            rung's level on the orbit: see ``tribodynamics._attractor_means``).
+            rung's level on the orbit: see ``tribodynamics.second_pass.attractor_means``).
             0: report the unstable periodic orbit, flagged (status 2), as before. Default 256:
             the mean mesh force of the chaotic rattles of the calibrated pair comes within 2 % of
             T1/rb1 (its exact long-time mean) over 256 cycles, against 4-11 % over 32 (the

@@ -49,7 +49,7 @@ from .fidelity import Fidelity
 from .gear.geometry import gear_geometry
 from .gear.pair import RELIEF_SHAPES, GearPair, TipRelief
 from .operating import OperatingPoint
-from .tribodynamics import check_inputs, simulate_with_state
+from .tribodynamics import check_inputs, first_pass
 
 # Status codes of an optimisation.
 STATUS_CONVERGED = 0  # projected gradient below tolerance
@@ -344,7 +344,9 @@ def _mean_efficiency(pair, lubricant, surfaces, op, speeds, fidelity):
         point = OperatingPoint(
             torque=op.torque, speed_rpm=speed, inlet_temperature=op.inlet_temperature
         )
-        result = simulate_with_state(pair, lubricant, surfaces, point, fidelity)[0]
+        # the second pass deferred: a point that needs it (no stable orbit, back strikes) counts
+        # as not converged, and its derivative is NaN
+        result = first_pass(pair, lubricant, surfaces, point, fidelity)[0]
         return result.efficiency, result.converged
 
     eff, ok = jax.vmap(one)(speeds)

@@ -23,9 +23,12 @@ from .sweep_engine import run_continuation, run_points
 from .tribodynamics import (
     STATUS_ATTRACTOR,
     STATUS_NAMES,
+    STATUS_PENDING,
     check_inputs,
     cold_start,
-    simulate_with_state,
+    finish,
+    first_pass,
+    needs_second_pass,
 )
 
 #: Inputs a sweep may vary, besides the speed.
@@ -178,34 +181,69 @@ def _outputs(result):
     return out
 
 
+def _first_outputs(result, pending, fidelity):
+    out = _outputs(result)
+    out["later"] = needs_second_pass(pending, fidelity)
+    if pending is not None:
+        out["pending"] = pending
+    return out
+
+
 # Module-level point and step functions taking the shared inputs as an argument: the sweep engine keeps
 # their compiled chunks, so a second sweep (another torque, lubricant, surface finish...) with the same
 # fidelity and shapes does not compile again.
 def _point(point, shared):
     pair, lubricant, surfaces, op, fidelity = shared
     p, s, o = _apply(pair, surfaces, op, point)
-    return _outputs(simulate_with_state(p, lubricant, s, o, fidelity)[0])
+    result, _, pending = first_pass(p, lubricant, s, o, fidelity)
+    return _first_outputs(result, pending, fidelity)
 
 
 def _step(warm, point, shared):
     pair, lubricant, surfaces, op, fidelity = shared
     p, s, o = _apply(pair, surfaces, op, point)
-    result, new_warm = simulate_with_state(p, lubricant, s, o, fidelity, warm)
-    # A failed point must not poison the rest of the march: keep the last good state. A point on an
-    # attractor (status 6, not converged) hands on its attractor only, so that the next speed
-    # without a stable orbit continues from it; a converged point clears it (its flag is 0).
-    good = result.converged
+    result, new_warm, pending = first_pass(p, lubricant, s, o, fidelity, warm)
+    # A failed point must not poison the rest of the march: keep the last good state (a stable
+    # orbit whose back-flank loss the second pass adds is a good state).
+    good = result.converged | (result.status == STATUS_PENDING)
     carry = jax.tree_util.tree_map(lambda a, b: jnp.where(good, a, b), new_warm, warm)
-    on_attractor = result.status == STATUS_ATTRACTOR
-    carry = eqx.tree_at(
-        lambda w: (w.attractor, w.on_attractor),
-        carry,
-        (
-            jnp.where(on_attractor, new_warm.attractor, carry.attractor),
-            jnp.where(on_attractor, new_warm.on_attractor, carry.on_attractor),
-        ),
-    )
-    return carry, _outputs(result)
+    return carry, _first_outputs(result, pending, fidelity)
+
+
+@eqx.filter_jit
+def _finish_point(point, pending, warm_attractor, shared):
+    pair, lubricant, surfaces, op, fidelity = shared
+    p, s, o = _apply(pair, surfaces, op, point)
+    result, handover = finish(p, lubricant, s, o, fidelity, pending, warm_attractor)
+    return _outputs(result), handover
+
+
+def _second_pass(out, raw_status, inputs, shared, continuation: bool):
+    """Run ``finish`` on the points whose first pass asks for it (no stable orbit, back-flank
+    strikes), one after the other, and put their outputs in place. In a continuation sweep a
+    point without a stable orbit right after another continues from that one's attractor record
+    (the paper's stepwise speed increase)."""
+    later = np.asarray(out.pop("later")).astype(bool) & (np.asarray(raw_status) < 2)
+    pending_all = out.pop("pending", None)
+    idx = np.nonzero(later)[0]
+    if idx.size == 0 or pending_all is None:
+        return out
+    dtype = np.asarray(out["power_loss"]).dtype
+    handover = (jnp.zeros(13, dtype), jnp.zeros((), dtype))
+    previous = -2
+    for i in idx:
+        point = {k: jnp.asarray(v[i]) for k, v in inputs.items()}
+        pending = jax.tree_util.tree_map(lambda a, i=i: jnp.asarray(a[i]), pending_all)
+        warm = handover if (continuation and previous == i - 1) else (
+            jnp.zeros(13, dtype), jnp.zeros((), dtype)
+        )
+        new, handover = _finish_point(point, pending, warm, shared)
+        previous = i
+        for k, v in new.items():
+            arr = np.array(out[k])
+            arr[i] = np.asarray(v)
+            out[k] = arr
+    return out
 
 
 def sweep(
@@ -314,7 +352,7 @@ def sweep(
             progress=progress,
             label="continuation",
         )
-    out = raw.outputs
+    out = _second_pass(dict(raw.outputs), raw.status, inputs, shared, mode == "continuation")
     status = np.where(raw.status >= 2, 5, np.asarray(out["sim_status"])).astype(np.int32)
     return SweepResult(
         inputs=inputs,

@@ -20,16 +20,40 @@ from jaxgear.tribodynamics import (
     STATUS_ATTRACTOR,
     STATUS_DYNAMICS,
     STATUS_NAMES,
-    cold_start,
-    simulate_with_state,
+    finish,
+    first_pass,
 )
 
 PAIR = jg.presets.li2015_pair_calibrated()
 OPTS = DynamicsOptions(n_positions=32)
 MESH = jg.mesh_cycle(PAIR, torque=700.0, n_positions=32)
 T1_OVER_RB1 = float(MESH.total_load)
-# one point of a continuation sweep (what jg.sweep scans), compiled once for cold and warm starts
-_STEP = eqx.filter_jit(simulate_with_state)
+
+
+class _Handover(eqx.Module):
+    """The end of a point's attractor record, handed to the next point of a continuation."""
+
+    attractor: jax.Array
+    on_attractor: jax.Array
+
+
+def cold_start(n_positions):
+    del n_positions
+    return _Handover(jnp.zeros(13), jnp.zeros(()))
+
+
+def _two_passes(pair, lub, surf, op, fid, handover):
+    """One point of a continuation sweep as jg.sweep runs it: the fixed point (first pass), then
+    the attractor (second pass, ``finish``) from the previous point's record."""
+    _, _, pending = first_pass(pair, lub, surf, op, fid)
+    result, (state, flag) = finish(
+        pair, lub, surf, op, fid, pending, (handover.attractor, handover.on_attractor)
+    )
+    return result, _Handover(state, flag)
+
+
+# one point of a continuation sweep (what jg.sweep runs), compiled once for cold and warm starts
+_STEP = eqx.filter_jit(_two_passes)
 
 
 def _op(rpm):
@@ -128,7 +152,7 @@ def test_simulate_reports_means_over_the_attractor_where_no_orbit_is_stable(at_3
 
 def test_a_continuation_sweep_carries_the_attractor_to_the_next_speed(at_3450):
     """The paper's stepwise speed increase: a point with no stable orbit hands the end of its
-    record to the next (``WarmStart.attractor``), which settles from it for ATTRACTOR_WARM_SETTLE
+    record to the next (the handover of ``tribodynamics.finish``), which settles from it for ATTRACTOR_WARM_SETTLE
     cycles instead of ``settle_periods`` from a kicked orbit. Checked against what it did not
     produce: the same speed settled cold; at the default fidelity the 3475 rpm attractor is not
     periodic, so the two records are different windows of one attractor (measured: Φ̄ −0.2 %,
@@ -218,12 +242,13 @@ def test_sweep_sends_only_points_without_a_stable_orbit_to_the_attractor_slow():
 @pytest.mark.slow
 def test_ehl_rung_attractor_means_follow_exact_ehl_solves_slow():
     """On the EHL rungs the attractor's contacts come from the closed-form mixed EHL contact scaled
-    to the rung's level on the orbit (``tribodynamics._attractor_means``). Checked against what it
+    to the rung's level on the orbit (``tribodynamics.second_pass.attractor_means``). Checked against what it
     stands in for: the rung's own EHL solves at every recorded load and velocity of the same record
     (rebuilt here from the returned WarmStart: the record is deterministic)."""
+    from jaxgear.dynamics.attractor import DEFAULT_KICK, record_attractor
     from jaxgear.dynamics.model import build_dynamics
-    from jaxgear.dynamics.response import DEFAULT_KICK, record_attractor
-    from jaxgear.tribodynamics import _cycle_contacts, _dynamics_options, simulate_with_state
+    from jaxgear.tribodynamics import simulate_with_state
+    from jaxgear.tribodynamics.fixed_point import cycle_contacts, dynamics_options
 
     lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
     op = _op(3450.0)
@@ -236,7 +261,7 @@ def test_ehl_rung_attractor_means_follow_exact_ehl_solves_slow():
     assert float(res.power_loss_back) == 0.0
 
     mesh = jg.mesh_cycle(PAIR, op.torque, fid.n_positions, stiffness=fid.stiffness)
-    options = _dynamics_options(fid)
+    options = dynamics_options(fid)
     dyn = build_dynamics(PAIR, op, mesh, warm.interface, options)
     rec = record_attractor(
         dyn, mesh, warm.orbit, options, fid.settle_periods, fid.attractor_periods, DEFAULT_KICK
@@ -245,7 +270,7 @@ def test_ehl_rung_attractor_means_follow_exact_ehl_solves_slow():
     assert np.asarray(rec.tooth_force).mean(0) == pytest.approx(np.asarray(res.tooth_force))
 
     def exact(wu):
-        return _cycle_contacts(PAIR, lub, surf, op, fid, mesh, wu[0], wu[1])[0]
+        return cycle_contacts(PAIR, lub, surf, op, fid, mesh, wu[0], wu[1])[0]
 
     per_cycle = jax.jit(lambda w, u: jax.lax.map(exact, (w, u)))(
         rec.tooth_force, rec.surface_velocity
@@ -321,14 +346,14 @@ def test_a_mean_over_the_attractor_reports_nan_derivatives_not_a_part_of_them(at
     field's tangent NaN where the flag holds, leaves it unchanged elsewhere, and leaves the values
     alone (checked on the real status-6 result's fields; the slow test below runs it through
     ``simulate``)."""
-    from jaxgear.tribodynamics import _without_derivative_where
+    from jaxgear.tribodynamics.result import without_derivative_where
 
     res = at_3450[0]
     assert int(res.status) == STATUS_ATTRACTOR
 
     def marked(t, flag):
         scaled = jax.tree_util.tree_map(lambda a: a * t if eqx.is_inexact_array(a) else a, res)
-        return _without_derivative_where(scaled, flag)
+        return without_derivative_where(scaled, flag)
 
     one = (jnp.asarray(1.0),)
     values, tangents = jax.jvp(lambda t: marked(t, res.status == STATUS_ATTRACTOR), one, one)

@@ -3,7 +3,7 @@
 ``gear.mesh.back_flank_mesh`` places their contacts from the mirror image of the drive mesh; the
 checks here build the teeth another way, as involute curves through the contact points in the
 plane of the gears, and measure the tooth thickness between the two flanks. The back flanks'
-loss (``tribodynamics._back_flank_power``) is checked against the drive flanks' quasi-static loss
+loss (``tribodynamics.second_pass.back_flank_power``) is checked against the drive flanks' quasi-static loss
 at the same load, which the mirror symmetry makes equal over a cycle.
 """
 
@@ -18,7 +18,8 @@ import jaxgear as jg
 from jaxgear.fidelity import Fidelity
 from jaxgear.gear.geometry import gear_geometry
 from jaxgear.gear.mesh import back_flank_mesh, mesh_cycle
-from jaxgear.tribodynamics import _back_flank_power, _cycle_contacts
+from jaxgear.tribodynamics.fixed_point import cycle_contacts
+from jaxgear.tribodynamics.second_pass import back_flank_power
 
 
 def _involute(rb, beta, t, hand):
@@ -105,14 +106,14 @@ def _static_losses(pair, m):
     mesh = mesh_cycle(pair, op.torque, m)
 
     def contacts(w, u, mm):
-        return _cycle_contacts(pair, lub, surf, op, fid, mm, w, u)[0]
+        return cycle_contacts(pair, lub, surf, op, fid, mm, w, u)[0]
 
     force = -jnp.full((1, m), float(mesh.total_load))
-    sliding, rolling = _back_flank_power(pair, op, fid, mesh, force, contacts)
+    sliding, rolling = back_flank_power(pair, op, fid, mesh, force, contacts)
     assert float(jnp.max(jnp.abs(rolling))) == 0.0  # the constant-μ rung has no rolling loss
     # none where the mesh force is positive (drive contact) or zero (separation)
     for other in (-force, jnp.zeros_like(force)):
-        assert float(jnp.max(_back_flank_power(pair, op, fid, mesh, other, contacts)[0])) == 0.0
+        assert float(jnp.max(back_flank_power(pair, op, fid, mesh, other, contacts)[0])) == 0.0
     return float(drive.power_loss), float(jnp.mean(sliding))
 
 
@@ -201,7 +202,8 @@ def test_reversed_torque_settles_on_the_back_flanks_static_te():
     import equinox as eqx
 
     from jaxgear.dynamics.model import LENGTH_SCALE
-    from jaxgear.dynamics.response import _batch_solve, _index, _postprocess, static_guess
+    from jaxgear.dynamics.response import postprocess
+    from jaxgear.dynamics.shooting import periodic_orbit, static_guess
 
     pair = jg.presets.li2015_pair()
     dyn, mesh, back, options = _back_dynamics(pair, 64, speed_rpm=10.0)
@@ -211,10 +213,11 @@ def test_reversed_torque_settles_on_the_back_flanks_static_te():
     # bearings deflected the other way
     shift = (-pair.backlash - back.static_te[0] - mesh.static_te[0]) / LENGTH_SCALE
     w = w.at[0].add(0.5 * shift).at[3].add(-0.5 * shift).at[1].multiply(-1).at[4].multiply(-1)
-    batch = jax.tree_util.tree_map(lambda a: a[None], dyn)
-    ws, aux = jax.jit(lambda b, w0: _batch_solve(b, w0, options))(batch, w[None])
+    ws, stats, flow = jax.jit(lambda d, w0: periodic_orbit(d, w0, options, mesh.n_positions))(
+        dyn, w
+    )
     op = jg.OperatingPoint(torque=700.0, speed_rpm=10.0)
-    res = _postprocess(dyn, mesh, op, ws[0], _index(aux, 0), options)
+    res = postprocess(dyn, mesh, op, ws, stats, flow)
     assert int(res.status) == 0
     assert float(np.min(res.back_contact)) == 1.0  # on the back flanks all cycle
     rb = np.asarray(dyn.base_radius)
@@ -330,7 +333,7 @@ def test_a_periodic_orbit_that_strikes_the_back_flanks_counts_their_loss():
     # mesh's quasi-static load shares, at the kinematic speeds of its radii of curvature.
     import equinox as eqx
 
-    from jaxgear.tribodynamics import SIGN_SLIDE_TO_ROLL
+    from jaxgear.contact import SIGN_SLIDE_TO_ROLL
 
     pair = eqx.tree_at(lambda p: p.backlash, jg.presets.li2015_pair_calibrated(), 5e-6)
     lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()

@@ -88,16 +88,17 @@ def test_a_nan_tooth_force_is_reported_not_dropped_from_the_loss():
     import equinox as eqx
 
     from jaxgear.fidelity import Fidelity
-    from jaxgear.tribodynamics import STATUS_NON_FINITE, STATUS_OK, _quasi_static
+    from jaxgear.tribodynamics import STATUS_NON_FINITE, STATUS_OK
+    from jaxgear.tribodynamics.fixed_point import quasi_static
 
     pair = jg.presets.li2015_pair()
     fid = Fidelity(dynamics="quasi_static", friction="constant", n_positions=24)
     op = jg.OperatingPoint(torque=700.0, speed_rpm=2000.0)
     mesh = jg.mesh_cycle(pair, op.torque, 24)
     args = (pair, jg.presets.mil_l_23699(), jg.presets.ground(), op, fid)
-    good = _quasi_static(*args, mesh)
+    good = quasi_static(*args, mesh)
     assert int(good.status) == STATUS_OK
     bad_mesh = eqx.tree_at(lambda m: m.normal_load, mesh, mesh.normal_load.at[3, 0].set(jnp.nan))
-    bad = _quasi_static(*args, bad_mesh)
+    bad = quasi_static(*args, bad_mesh)
     assert int(bad.status) == STATUS_NON_FINITE
     assert not bool(bad.converged)

@@ -11,10 +11,11 @@ import numpy as np
 import pytest
 
 import jaxgear as jg
+from jaxgear.contact import kinematic_velocities
 from jaxgear.fidelity import Fidelity
 from jaxgear.gear.geometry import mesh_period
 from jaxgear.lubrication.contacts import ehl_contact_forces, frozen_contact_forces
-from jaxgear.tribodynamics import kinematic_velocities, simulate
+from jaxgear.tribodynamics import simulate
 
 
 @pytest.fixture(scope="module")

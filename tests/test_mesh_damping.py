@@ -187,7 +187,8 @@ def test_the_coupled_model_reports_the_damper_power_of_its_orbit():
     # SimulationResult.mesh_damping_power is the converged orbit's (the dynamics re-run here
     # apart, on the fixed point's final tables and orbit, to 1e-6), not part of Φ̄, and 0 with
     # ζ = 0 or quasi-static.
-    from jaxgear.tribodynamics import _dynamics_options, simulate_with_state
+    from jaxgear.tribodynamics import simulate_with_state
+    from jaxgear.tribodynamics.fixed_point import dynamics_options
 
     base = jg.presets.li2015_pair_calibrated()
     pair = eqx.tree_at(lambda p: p.mesh_damping_ratio, base, jnp.asarray(0.05))
@@ -202,7 +203,7 @@ def test_the_coupled_model_reports_the_damper_power_of_its_orbit():
         op,
         mesh=mesh,
         interface=warm.interface,
-        options=_dynamics_options(fid),
+        options=dynamics_options(fid),
         initial_state=warm.orbit,
     )
     power = float(res.mesh_damping_power)

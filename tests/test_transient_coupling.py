@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 import jaxgear as jg
+from jaxgear.contact import kinematic_velocities
 from jaxgear.gear.geometry import mesh_period
 from jaxgear.gear.mesh import mesh_cycle
 from jaxgear.lubrication.contacts import ehl_contact_forces
-from jaxgear.tribodynamics import kinematic_velocities
 
 jax.config.update("jax_enable_x64", True)
 

@@ -247,8 +247,8 @@ def test_ehl_contact_forces_have_finite_tangents_on_unloaded_slots(setup):
     # friction coefficient was sqrt(Fs² + Fr²)/W at Fs = Fr = 0, whose tangent is NaN, and that NaN
     # made every tribo-dynamic EHL gradient NaN. Every tangent must be finite, zero where masked,
     # and equal to central differences where loaded.
+    from jaxgear.contact import kinematic_velocities
     from jaxgear.lubrication.contacts import ehl_contact_forces
-    from jaxgear.tribodynamics import kinematic_velocities
 
     pair, lub, surf = setup
     fid = Fidelity(dynamics="quasi_static", friction="ehl_smooth", n_positions=24, n_nodes=65)

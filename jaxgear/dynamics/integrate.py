@@ -101,22 +101,27 @@ def blocks_needed(dyn: GearDynamics, options: DynamicsOptions, n_positions: int)
 
 
 def _rk_step(dyn: GearDynamics, tableau, t, y, s, h):
-    """One explicit RK step of the augmented state y = [z (12), E] from τ = t: (y_new).
+    """One explicit RK step of the augmented state y = [z (12), E] from τ = t (returns y_new).
 
-    Stages after the last nonzero weight of ``b_sol`` are not evaluated (FSAL stages)."""
-    b = np.asarray(tableau.b_sol)
+    The stages run in a loop over one evaluation of the vector field (traced once, not once per
+    stage: the field is most of the program). Stages after the last nonzero weight of ``b_sol``
+    are not evaluated (FSAL stages)."""
+    b = np.asarray(tableau.b_sol, dtype=float)
     used = int(np.nonzero(b)[0].max()) + 1
+    a = np.zeros((used, used))
+    for i in range(1, used):
+        row = np.asarray(tableau.a_lower[i - 1], dtype=float)
+        a[i, : row.shape[0]] = row
+    c = np.concatenate([[0.0], np.asarray(tableau.c, dtype=float)[: used - 1]])
+    a, b, c = (jnp.asarray(x, dtype=y.dtype) for x in (a, b[:used], c))
 
-    def f(tau, y):
-        dz, power = dyn.rate_and_damper_power(tau, y[:12], s)
-        return jnp.concatenate([dz, power[None]])
+    def stage(i, ks):
+        yi = y + h * (a[i] @ ks)
+        dz, power = dyn.rate_and_damper_power(t + c[i] * h, yi[:12], s)
+        return ks.at[i].set(jnp.concatenate([dz, power[None]]))
 
-    ks = [f(t, y)]
-    for i in range(used - 1):
-        a = np.asarray(tableau.a_lower[i])
-        yi = y + h * sum(float(a[j]) * ks[j] for j in range(len(ks)) if a[j] != 0.0)
-        ks.append(f(t + float(tableau.c[i]) * h, yi))
-    return y + h * sum(float(b[j]) * ks[j] for j in range(used) if b[j] != 0.0)
+    ks = jax.lax.fori_loop(0, used, stage, jnp.zeros((used, y.shape[0]), y.dtype))
+    return y + h * (b @ ks)
 
 
 def period_flow(dyn: GearDynamics, w, options: DynamicsOptions, n_positions: int) -> PeriodFlow:

@@ -69,7 +69,7 @@ def ehl_contact_forces(
         period: the mesh period, s; needed by ``fidelity.transient`` (the time between positions
             is period / M).
     """
-    from ..tribodynamics import ContactForces
+    from ..contact.base import ContactForces
 
     model = ehl_model_of(fidelity)
     rough = surfaces if fidelity.friction == "ehl_mixed" else None
@@ -178,7 +178,7 @@ def frozen_contact_forces(
     vibration loads where the static mesh does not still carries friction; slots unloaded now carry
     none. ``converged`` and ``failed`` are the reference's.
     """
-    from ..tribodynamics import ContactForces
+    from ..contact.base import ContactForces
 
     def in_use(w, u):
         return (w > LOADED_SHARE * total_load) & (u[..., 0] + u[..., 1] > 0)
@@ -260,7 +260,7 @@ def coefficient_scales(w, u1, u2):
     W us s, W um (``w`` a load, per width or not; s = us/(us² + (0.02 um)²)^½ the sign of
     us = u2 − u1 smoothed over 2 % slide-to-roll ratio, as the formula rungs' friction). A constant
     μ gives Fs = μ W s and Φs = Fs us = μ W us s: constant coefficients, whatever the velocities."""
-    from ..tribodynamics import SIGN_SLIDE_TO_ROLL
+    from ..contact.base import SIGN_SLIDE_TO_ROLL
 
     us = u2 - u1
     um = 0.5 * (u1 + u2)
