@@ -48,7 +48,7 @@ import equinox as eqx  # noqa: E402
 from _report import machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear.fidelity_auto import (  # noqa: E402
+from jaxgear.fidelity.choose import (  # noqa: E402
     AXIS_ORDER,
     INDICATOR_VERSION,
     QUANTITIES,
@@ -641,7 +641,7 @@ def write_report(table, studies, figure_path, wall, quick, write=True):
 def auto_and_reach(table) -> list[str]:
     """Fidelity.auto on the measured scenarios (in-sample: the table was set from them) and the
     issue's Reach numbers, both against this table's reference."""
-    from jaxgear.fidelity_auto import choose_from_indicators
+    from jaxgear.fidelity.choose import choose_from_indicators
 
     ref = table["reference"]
     good = [n for n, s in table["scenarios"].items() if s["reference_converged"]]

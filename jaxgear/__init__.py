@@ -31,10 +31,10 @@ from .dynamics import dynamic_response_sweep as dynamic_response_sweep
 from .dynamics import mode_shapes as mode_shapes
 from .dynamics import natural_frequencies as natural_frequencies
 from .fidelity import Fidelity as Fidelity
-from .fidelity_auto import FidelityChoice as FidelityChoice
-from .fidelity_auto import ScenarioIndicators as ScenarioIndicators
-from .fidelity_auto import choose_fidelity as choose_fidelity
-from .fidelity_auto import scenario_indicators as scenario_indicators
+from .fidelity.choose import FidelityChoice as FidelityChoice
+from .fidelity.choose import ScenarioIndicators as ScenarioIndicators
+from .fidelity.choose import choose_fidelity as choose_fidelity
+from .fidelity.choose import scenario_indicators as scenario_indicators
 from .lubrication import thermal as thermal
 from .lubrication.ehl import EHLModel as EHLModel
 from .lubrication.ehl import EHLSolution as EHLSolution

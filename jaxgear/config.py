@@ -390,13 +390,14 @@ def surfaces_from_config(cfg: dict[str, Any]):
 
 
 def _fidelity_keys() -> dict:
-    from .fidelity import Fidelity
+    from .fidelity.ladder import FLAT_DEFAULTS
 
     keys: dict[str, Any] = {"preset": str, "tolerance": float}
-    for f in dataclasses.fields(Fidelity):
-        # a None default (fixed_point_tolerance: chosen by the rung) is given as a number or left out
-        kind = float if f.default is None else type(f.default)
-        keys[f.name] = {bool: bool, int: int, float: float, str: str}[kind]
+    for name, default in FLAT_DEFAULTS.items():
+        # a None default (fixed_point_tolerance: chosen by the rung; limiting_shear_coefficient:
+        # no cap) is given as a number or left out
+        kind = float if default is None else type(default)
+        keys[name] = {bool: bool, int: int, float: float, str: str}[kind]
     return keys
 
 
@@ -410,7 +411,7 @@ def fidelity_from_config(cfg: dict[str, Any], preset: str | None = None):
     them; ``tolerance`` (default 0.05) is the choice's tolerance and the caller makes the choice
     (it needs the scenario: see ``sweep_from_config``)."""
     from .fidelity import Fidelity
-    from .fidelity_auto import LADDER_FIELDS
+    from .fidelity.choose import LADDER_FIELDS
 
     table = dict(cfg.get("fidelity", {}))
     check_keys(table, _fidelity_keys(), "fidelity")
@@ -606,7 +607,7 @@ def _auto_fidelity(pair, lub, surf, op, speeds, vary, base, tolerance):
     """``[fidelity] preset = "auto"``: ``jg.choose_fidelity`` over the sweep's speeds, keeping the
     base's other fields. The indicators are those of ``[operating]``, so inputs that move them may
     not vary per speed."""
-    from .fidelity_auto import choose_fidelity
+    from .fidelity.choose import choose_fidelity
 
     moving = sorted(k for k in vary if k != "tip_relief_amount")
     if moving:

@@ -1190,7 +1190,7 @@ def write_report(repro: PaperReproduction, out_dir: str | Path) -> dict:
             csvs.append(result.to_csv(data / f"variant_{name}.csv"))
     (out / "paper_table.json").write_text(json.dumps(rows, indent=1))
     manifest = {
-        "fidelity": {f.name: getattr(fid, f.name) for f in dataclasses.fields(fid)},
+        "fidelity": fid.flat(),
         "quick": repro.quick,
         "speeds_rpm": [float(repro.speeds[0]), float(repro.speeds[-1]), int(repro.speeds.size)],
         "variant_speeds_rpm": [

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import jaxgear as jg
-from jaxgear.fidelity_auto import (
+from jaxgear.fidelity.choose import (
     AXIS_ORDER,
     QUANTITIES,
     choose_fidelity,
@@ -370,7 +370,7 @@ def test_shipped_table_is_consistent():
 def test_shipped_table_envelope_dominates_its_own_measurements():
     """At a measured scenario, a rung that departs from the reference on one axis only is never
     predicted better than it measured there (the envelope is conservative on its own data)."""
-    from jaxgear.fidelity_auto import _predict, _Table
+    from jaxgear.fidelity.choose import _predict, _Table
 
     tab = _Table(load_error_table())
     checked = 0

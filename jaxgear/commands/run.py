@@ -168,7 +168,7 @@ def _fidelity(args, pair, lub, surf, op, speeds):
 
     if args.fidelity != "auto":
         return Fidelity.named(args.fidelity), None
-    from jaxgear.fidelity_auto import choose_fidelity
+    from jaxgear.fidelity.choose import choose_fidelity
 
     choice = choose_fidelity(pair, lub, surf, op, args.tolerance, speeds_rpm=speeds)
     print(choice.reasons, flush=True)

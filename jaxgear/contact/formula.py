@@ -106,7 +106,9 @@ def formula_ehl_contact_forces(
         density_product=fidelity.asperity_density_product,
         slope_ratio=fidelity.asperity_slope_ratio,
         sign_width=SIGN_SLIDE_TO_ROLL * 0.5 * jnp.abs(ve) + 1e-9,
-        limiting_shear=fidelity.limiting_shear_coefficient,
+        limiting_shear=(
+            fidelity.limiting_shear_coefficient if fidelity.contact.limiting_shear else None
+        ),
     )
     on = loaded & ok_u
     per_pair = lambda x: jnp.where(on, x * width, 0.0)

@@ -33,7 +33,7 @@ def gt_integral(order: float, lam):
 
 def asperity_constant(density_product, slope_ratio):
     """K′ = (8√2/15) π (nβσ)² √(σ/β)."""
-    return 8.0 * math.sqrt(2.0) / 15.0 * math.pi * density_product**2 * math.sqrt(slope_ratio)
+    return 8.0 * math.sqrt(2.0) / 15.0 * math.pi * density_product**2 * jnp.sqrt(slope_ratio)
 
 
 def asperity_pressure(h, sigma, e_reduced, density_product, slope_ratio):

@@ -41,7 +41,9 @@ def ehl_model_of(fidelity) -> EHLModel:
         shear=fidelity.shear,
         asperity_density_product=fidelity.asperity_density_product,
         asperity_slope_ratio=fidelity.asperity_slope_ratio,
-        limiting_shear_coefficient=fidelity.limiting_shear_coefficient,
+        limiting_shear_coefficient=(
+            fidelity.limiting_shear_coefficient if fidelity.contact.limiting_shear else None
+        ),
     )
 
 

@@ -52,7 +52,11 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-from .fidelity import Fidelity
+from ..dynamics.modes import mode_shapes
+from ..gear.geometry import gear_geometry, hertz_half_width, hertz_pressure, normal_load
+from ..gear.mesh import mesh_cycle
+from ..material import reduced_modulus
+from .ladder import Fidelity
 
 #: Version of the indicator definitions; a table measured with other definitions is refused.
 INDICATOR_VERSION = 1
@@ -188,8 +192,6 @@ def _f(x) -> float:
 def _cycle_and_modes(pair, lubricant, surfaces, torque, inlet_temperature):
     """The traced part of the indicators, one compiled program: mean mesh stiffness and max Hertz
     pressure of the quasi-static mesh cycle, modes at that stiffness, η0, α and σ."""
-    from .dynamics.modes import mode_shapes
-    from .gear.mesh import mesh_cycle
 
     mesh = mesh_cycle(pair, torque, _INDICATOR_POSITIONS, stiffness="potential_energy")
     modes = mode_shapes(pair, jnp.mean(mesh.mesh_stiffness))
@@ -205,8 +207,6 @@ def _cycle_and_modes(pair, lubricant, surfaces, torque, inlet_temperature):
 
 def _speed_free_part(pair, lubricant, surfaces, torque, inlet_temperature) -> dict:
     """Everything the indicators need that does not depend on the speed."""
-    from .gear.geometry import gear_geometry, hertz_half_width, hertz_pressure, normal_load
-    from .material import reduced_modulus
 
     geo = gear_geometry(pair)
     s_pitch = _f(geo.pitch_point)
@@ -526,11 +526,11 @@ def _settings_note(base: Fidelity | None) -> str | None:
     at (benchmarks/fidelity_trade.py runs every rung with Fidelity()'s other fields)."""
     if base is None:
         return None
-    default = Fidelity()
+    kept, default = base.flat(), Fidelity().flat()
     changed = [
-        f"{f.name} = {getattr(base, f.name)!r} (table: {getattr(default, f.name)!r})"
-        for f in dataclasses.fields(Fidelity)
-        if f.name not in LADDER_FIELDS and getattr(base, f.name) != getattr(default, f.name)
+        f"{name} = {kept[name]!r} (table: {default[name]!r})"
+        for name in kept
+        if name not in LADDER_FIELDS and kept[name] != default[name]
     ]
     if not changed:
         return None
