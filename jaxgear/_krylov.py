@@ -51,18 +51,23 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
 
     Converged when ‖b̂ − Â x̂‖₂ ≤ rtol ‖b̂‖₂ + atol (hats: scaled by the root's per-leaf magnitudes;
     the true residual, checked at the end of each cycle). Not converged after ``max_restarts``
-    cycles: ``RESULTS.max_steps_reached`` (lineax then raises, or reports it with ``throw=False``).
+    cycles (or a non-finite right-hand side): ``RESULTS.max_steps_reached``; with
+    ``nan_on_failure=True`` the solution is NaN and the result reported successful instead, so
+    that an implicit derivative that cannot be computed comes out NaN rather than lineax raising
+    from inside the transformation (the fixed point's adjoint).
 
     Args:
         rtol, atol: tolerances on the scaled residual (see above).
         restart: Krylov vectors per cycle (the basis is stored: restart + 1 vectors).
         max_restarts: cycles before giving up.
+        nan_on_failure: on failure return NaN as successful (above) instead of a failed result.
     """
 
     rtol: float
     atol: float
     restart: int = eqx.field(static=True, default=30)
     max_restarts: int = eqx.field(static=True, default=20)
+    nan_on_failure: bool = eqx.field(static=True, default=False)
 
     def init(self, operator, options):
         del options
@@ -165,8 +170,14 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
             (jnp.zeros_like(b), jnp.linalg.norm(b), jnp.asarray(0), jnp.asarray(0)),
         )
         ok = res <= tol
-        result = lx.RESULTS.where(ok, lx.RESULTS.successful, lx.RESULTS.max_steps_reached)
-        return unravel(flat_d * x), result, {"num_steps": steps, "residual": res}
+        if self.nan_on_failure:
+            # a derivative that cannot be computed is NaN, never an exception from inside a
+            # transformation (lineax raises on a failed result)
+            x = jnp.where(ok, x, jnp.nan)
+            result = lx.RESULTS.successful
+        else:
+            result = lx.RESULTS.where(ok, lx.RESULTS.successful, lx.RESULTS.max_steps_reached)
+        return unravel(flat_d * x), result, {"num_steps": steps, "residual": res, "converged": ok}
 
     def transpose(self, state, options):
         operator, scales = state
