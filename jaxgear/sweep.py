@@ -16,6 +16,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ._inputs import canonical, validate
 from .fidelity import Fidelity
 from .operating import OperatingPoint
 from .sweep_engine import STATUS_NAMES as POINT_STATUS_NAMES
@@ -283,6 +284,8 @@ def sweep(
     """
     fidelity = Fidelity.fast() if fidelity is None else fidelity
     check_inputs(pair, lubricant, surfaces, op, fidelity)
+    pair, lubricant, surfaces, op, fidelity = canonical((pair, lubricant, surfaces, op, fidelity))
+    validate((pair, lubricant, surfaces, op, fidelity))
     if mode not in ("parallel", "continuation"):
         raise ValueError(f"mode = {mode!r} is not valid; valid choices: 'parallel', 'continuation'")
     if chunk_size is not None and (

@@ -129,8 +129,10 @@ def simulate(
     """
     fidelity = Fidelity.fast() if fidelity is None else fidelity
     check_inputs(pair, lubricant, surfaces, op, fidelity)
-    pair, lubricant, surfaces, op = canonical((pair, lubricant, surfaces, op))
-    validate((pair, lubricant, surfaces, op))
+    # a field substituted by eqx.tree_at with a Python float becomes a float64 array here (not a
+    # static leaf: no recompilation per value), and is checked as its constructor would
+    pair, lubricant, surfaces, op, fidelity = canonical((pair, lubricant, surfaces, op, fidelity))
+    validate((pair, lubricant, surfaces, op, fidelity))
     if is_concrete(surfaces):
         check_non_negative("surfaces.composite_rq", surfaces.composite_rq, "m")
     gear_geometry(pair)
