@@ -502,7 +502,7 @@ def _solve_contact(repro, result, index, i, slot, label, deterministic=False):
             thermal=False,
             boundary_friction=fid.boundary_friction,
             shear=fid.shear,
-            limiting_shear_coefficient=fid.limiting_shear_coefficient,
+            limiting_shear_coefficient=fid.flat()["limiting_shear_coefficient"],
         )
         what = (
             f"deterministic roughness (profiles filtered at λs = {FIELD_SHORT_CUTOFF * 1e6:g} "
@@ -610,11 +610,11 @@ def _contact_parameters(fid):
     if fid.shear != default.shear:
         parts.append(f"shear {fid.shear!r}")
     if fid.asperity_density_product != default.asperity_density_product:
-        parts.append(f"nβσ {fid.asperity_density_product:g}")
+        parts.append(f"nβσ {float(fid.asperity_density_product):g}")
     if fid.asperity_slope_ratio != default.asperity_slope_ratio:
-        parts.append(f"σ/β {fid.asperity_slope_ratio:g}")
+        parts.append(f"σ/β {float(fid.asperity_slope_ratio):g}")
     if fid.boundary_friction != default.boundary_friction:
-        parts.append(f"μb {fid.boundary_friction:g}")
+        parts.append(f"μb {float(fid.boundary_friction):g}")
     return "".join(", " + p for p in parts)
 
 

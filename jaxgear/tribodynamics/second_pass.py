@@ -134,8 +134,10 @@ def orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
     parallel sweep at ``Fidelity.fast()`` 12 %: 40.5 against 36.0 s compiled)."""
     force = st["back_force"][None]  # [1, M]
 
+    # the fidelity goes in the operand: its constants are arrays of this trace, which a branch
+    # must not close over (the lazy cond's JVP rule re-traces its branches)
     def strikes(operand):
-        pair, lubricant, surfaces, op, mesh, st, force = operand
+        pair, lubricant, surfaces, op, fidelity, mesh, st, force = operand
         each = record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st)
         return back_flank_power(pair, op, fidelity, mesh, force, each)
 
@@ -144,7 +146,7 @@ def orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
         zero = jnp.zeros(force.shape[-1], dtype=force.dtype)
         return zero, zero
 
-    operand = (pair, lubricant, surfaces, op, mesh, st, force)
+    operand = (pair, lubricant, surfaces, op, fidelity, mesh, st, force)
     power = cond_any_member(jnp.any(force < 0.0), strikes, none, operand, all_true_path=False)
     return jnp.mean((force < 0.0).astype(force.dtype)), power
 
@@ -181,10 +183,13 @@ def attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status
     batch mixes stable and unstable points, the unstable ones run the branch one by one
     (``cond_any_member(..., mixed="map")``)."""
     keys = ("forces", "load", "velocity", "dte", "damper", "back_force", "interface", "guess")
-    operand = (pair, lubricant, surfaces, op, mesh, {k: state[k] for k in keys}, status, warm)
+    st = {k: state[k] for k in keys}
+    operand = (pair, lubricant, surfaces, op, fidelity, mesh, st, status, warm)
 
     def on_attractor(operand):
-        pair, lubricant, surfaces, op, mesh, st, status, warm = jax.lax.stop_gradient(operand)
+        pair, lubricant, surfaces, op, fidelity, mesh, st, status, warm = jax.lax.stop_gradient(
+            operand
+        )
         # built here, not closed over: its array fields are created in the trace they are used
         # in (closed over from the simulate trace they leaked when the JVP rule of the lazy cond
         # re-traced this branch: jax.jacfwd of simulate failed with "No constant handler")
@@ -246,7 +251,7 @@ def attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status
         return (picked, status, handover, back, back_power)
 
     def keep(operand):
-        pair, lubricant, surfaces, op, mesh, st, status, warm = operand
+        pair, lubricant, surfaces, op, fidelity, mesh, st, status, warm = operand
         off = (jnp.zeros_like(warm[0]), jnp.zeros_like(warm[1]))
         back = orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st)
         kept = (st["forces"], st["load"], st["velocity"], st["dte"], st["damper"])
