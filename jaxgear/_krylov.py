@@ -70,10 +70,10 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
     nan_on_failure: bool = eqx.field(static=True, default=False)
 
     def init(self, operator, options):
-        del options
         if not eqx.tree_equal(operator.in_structure(), operator.out_structure()):
             raise ValueError("EarlyExitGMRES needs a square operator (in and out structures equal)")
-        x = getattr(operator, "x", None)
+        # the point to scale by: the operator's linearisation point, or options["scale_point"]
+        x = (options or {}).get("scale_point", getattr(operator, "x", None))
         if x is None:
             scales = jax.tree_util.tree_map(
                 lambda s: jnp.ones((), dtype=s.dtype), operator.in_structure()

@@ -9,9 +9,9 @@ from .choose import scenario_indicators as scenario_indicators
 from .ladder import CONSTANTS as CONSTANTS
 from .ladder import COUPLING_RUNGS as COUPLING_RUNGS
 from .ladder import DYNAMICS_RUNGS as DYNAMICS_RUNGS
+from .ladder import FLAT_FIELDS as FLAT_FIELDS
 from .ladder import FRICTION_RUNGS as FRICTION_RUNGS
 from .ladder import NAMED_PRESETS as NAMED_PRESETS
-from .ladder import FLAT_FIELDS as FLAT_FIELDS
 from .ladder import ContactConstants as ContactConstants
 from .ladder import ContactModel as ContactModel
 from .ladder import CoupledDynamics as CoupledDynamics

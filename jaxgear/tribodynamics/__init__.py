@@ -3,6 +3,11 @@
 from .fixed_point import Pending as Pending
 from .fixed_point import WarmStart as WarmStart
 from .fixed_point import cold_start as cold_start
+from .passes import check_inputs as check_inputs
+from .passes import first_pass as first_pass
+from .passes import needs_second_pass as needs_second_pass
+from .passes import simulate as simulate
+from .passes import simulate_with_state as simulate_with_state
 from .result import STATUS_ATTRACTOR as STATUS_ATTRACTOR
 from .result import STATUS_CONTACT as STATUS_CONTACT
 from .result import STATUS_DYNAMICS as STATUS_DYNAMICS
@@ -15,8 +20,3 @@ from .result import SimulationResult as SimulationResult
 from .second_pass import ATTRACTOR_CONTACT_CYCLES as ATTRACTOR_CONTACT_CYCLES
 from .second_pass import ATTRACTOR_WARM_SETTLE as ATTRACTOR_WARM_SETTLE
 from .second_pass import finish as finish
-from .simulate import check_inputs as check_inputs
-from .simulate import first_pass as first_pass
-from .simulate import needs_second_pass as needs_second_pass
-from .simulate import simulate as simulate
-from .simulate import simulate_with_state as simulate_with_state

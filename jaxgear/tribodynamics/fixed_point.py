@@ -21,6 +21,7 @@ import jax.numpy as jnp
 import optimistix as optx
 from jaxtyping import Array, Float, Int
 
+from .._implicit import NaNImplicitAdjoint
 from .._krylov import EarlyExitGMRES
 from ..anderson import Anderson
 from ..contact.base import ContactForces, interface_from_forces, kinematic_velocities
@@ -287,7 +288,7 @@ def tribo_dynamic_fixed_point(pair, lubricant, surfaces, op, fidelity, mesh, war
     # instead of 3.0× (benchmarks/RESULTS.md, end_to_end).
     # A failed implicit solve (a singular I − ∂T/∂x, a non-finite right-hand side) gives NaN
     # derivatives, never an exception from inside the transformation.
-    adjoint = optx.ImplicitAdjoint(
+    adjoint = NaNImplicitAdjoint(
         linear_solver=EarlyExitGMRES(rtol=1e-10, atol=0.0, nan_on_failure=True)
     )
     sol = optx.fixed_point(

@@ -87,10 +87,12 @@ def simulate_with_state(pair, lubricant, surfaces, op, fidelity, warm: WarmStart
     return finish(pair, lubricant, surfaces, op, fidelity, pending)[0], warm_out
 
 
-@eqx.filter_jit
-def _first_pass_jit(pair, lubricant, surfaces, op, fidelity):
+def _first_pass_outputs(pair, lubricant, surfaces, op, fidelity):
     result, _, pending = first_pass(pair, lubricant, surfaces, op, fidelity)
     return result, pending, needs_second_pass(pending, fidelity)
+
+
+_first_pass_jit = eqx.filter_jit(_first_pass_outputs)
 
 
 @eqx.filter_jit

@@ -1,0 +1,180 @@
+"""The coupled model differentiated end to end: reverse mode over every float input and model
+constant, against forward mode and central differences; substitution that neither recompiles nor
+skips validation; a failed implicit solve that gives NaN, not an exception."""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+import pytest
+
+import jaxgear as jg
+import jaxgear.tribodynamics.passes as passes
+from jaxgear._implicit import NaNImplicitAdjoint
+from jaxgear._krylov import EarlyExitGMRES
+
+PAIR = jg.presets.li2015_pair_calibrated()
+LUB, SURF = jg.presets.mil_l_23699(), jg.presets.ground()
+OP = jg.OperatingPoint(torque=700.0, speed_rpm=2500.0, inlet_temperature=363.15)
+# the fixed point converged far below the default 1e-4 of its tables, so that central differences
+# of Ψ are not noise (a Ψ change of ~1e-10 per step below)
+FAST = jg.Fidelity.fast(fixed_point_tolerance=1e-10)
+
+# (label, getter, relative step of the central difference)
+CHECKED = (
+    ("torque", lambda t: t[2].torque, 1e-4),
+    ("relief amount", lambda t: t[0].tip_relief.amount, 1e-3),
+    ("relief start", lambda t: t[0].tip_relief.start_roll_angle, 1e-4),
+    ("module", lambda t: t[0].module, 1e-5),
+    ("pressure angle", lambda t: t[0].pressure_angle, 1e-5),
+    ("roughness scale", lambda t: t[1].scale, 1e-4),
+    ("boundary friction", lambda t: t[3].contact.constants.boundary_friction, 1e-4),
+    ("asperity density product", lambda t: t[3].contact.constants.asperity_density_product, 1e-4),
+)
+
+
+def _efficiency(inputs):
+    pair, surfaces, op, fidelity = inputs
+    return jg.simulate(pair, LUB, surfaces, op, fidelity=fidelity).efficiency
+
+
+def _split(inputs):
+    return eqx.partition(inputs, eqx.is_inexact_array)
+
+
+def _direction(inputs, get):
+    """A tangent of ``inputs`` that is 1 on the leaf ``get`` picks (both gears of a pair)."""
+    params, _ = _split(inputs)
+    zeros = jax.tree_util.tree_map(jnp.zeros_like, params)
+    return eqx.tree_at(get, zeros, jnp.ones_like(get(params)))
+
+
+@pytest.fixture(scope="module")
+def reverse_and_forward():
+    inputs = (PAIR, SURF, OP, FAST)
+    params, static = _split(inputs)
+
+    def psi(p):
+        return _efficiency(eqx.combine(p, static))
+
+    value, grads = jax.jit(jax.value_and_grad(psi))(params)
+    tangents = [_direction(inputs, get) for _, get, _ in CHECKED]
+    stacked = jax.tree_util.tree_map(lambda *a: jnp.stack(a), *tangents)
+    forward = jax.jit(jax.vmap(lambda t: jax.jvp(psi, (params,), (t,))[1]))(stacked)
+    return inputs, value, grads, np.asarray(forward)
+
+
+def test_reverse_gradient_of_efficiency_is_finite_for_every_float_input(reverse_and_forward):
+    inputs, value, grads, _ = reverse_and_forward
+    assert 0.99 < float(value) < 1.0
+    leaves = jax.tree_util.tree_leaves(grads)
+    # every float leaf of the pair, surfaces, operating point and fidelity (its constants)
+    assert len(leaves) == len(jax.tree_util.tree_leaves(_split(inputs)[0])) > 30
+    assert all(bool(jnp.all(jnp.isfinite(g))) for g in leaves)
+
+
+@pytest.mark.parametrize("index", range(len(CHECKED)), ids=[c[0] for c in CHECKED])
+def test_reverse_gradient_matches_forward_mode_and_central_differences(reverse_and_forward, index):
+    inputs, _, grads, forward = reverse_and_forward
+    label, get, rel = CHECKED[index]
+    reverse = float(jnp.sum(get(grads)))
+    # reverse against forward: the same implicit rules, transposed; round-off only
+    assert reverse == pytest.approx(float(forward[index]), rel=1e-6, abs=1e-14), label
+    # central differences of the compiled forward model: the step is the stated fraction of the
+    # value (both gears together for per-gear fields), truncation O(h²) ~1e-8 relative; the
+    # fixed point to 1e-10 and the orbit's Newton to 1e-9 leave noise ~1e-10 in Ψ. A wrong
+    # tangent (an unconverged implicit solve, a missed dependence) is off by far more than 1e-3.
+    x = get(inputs)
+    h = rel * float(jnp.max(jnp.abs(x)))
+
+    def at(shift):
+        return float(_efficiency(eqx.tree_at(get, inputs, x + shift)))
+
+    fd = (at(h) - at(-h)) / (2.0 * h)
+    assert reverse == pytest.approx(fd, rel=1e-3, abs=1e-12), (label, reverse, fd)
+
+
+def _counted_first_pass(monkeypatch):
+    fresh = eqx.filter_jit(
+        eqx.debug.assert_max_traces(passes._first_pass_outputs, max_traces=1)
+    )
+    monkeypatch.setattr(passes, "_first_pass_jit", fresh)
+
+
+def test_substituting_fields_with_python_floats_does_not_recompile(monkeypatch):
+    # eqx.tree_at puts the Python float in as it is; simulate turns it into a float64 array at its
+    # boundary, so the one compiled program runs every value (assert_max_traces raises on a
+    # second trace). A per-gear field takes its Python float through ``replace``, which
+    # broadcasts it to both gears (put in by tree_at, a scalar is refused: the test below).
+    _counted_first_pass(monkeypatch)
+    fid = jg.Fidelity.fast(dynamics="quasi_static")
+    base = jg.simulate(PAIR, LUB, SURF, OP, fidelity=fid)
+    variants = [  # (pair, operating point, fidelity)
+        (PAIR, eqx.tree_at(lambda o: o.torque, OP, 650.0), fid),
+        (PAIR.replace(**{"tip_relief.amount": 12e-6}), OP, fid),
+        (eqx.tree_at(lambda p: p.module, PAIR, 3.1e-3), OP, fid),
+        (PAIR, OP, eqx.tree_at(lambda f: f.contact.constants.boundary_friction, fid, 0.12)),
+    ]
+    losses = set()
+    for pair, op, f in variants:
+        res = jg.simulate(pair, LUB, SURF, op, fidelity=f)
+        assert int(res.status) == 0
+        losses.add(round(float(res.power_loss), 6))
+    # each substitution changed the answer (the value went in, not a constant of the program)
+    assert len(losses) == len(variants) and float(base.power_loss) not in losses
+
+
+def test_an_invalid_substituted_value_is_rejected_naming_the_field():
+    fid = jg.Fidelity.fast(dynamics="quasi_static")
+    bad_relief = eqx.tree_at(lambda p: p.tip_relief.amount, PAIR, jnp.asarray([-50e-6, -50e-6]))
+    with pytest.raises(ValueError, match=r"TipRelief\.amount"):
+        jg.simulate(bad_relief, LUB, SURF, OP, fidelity=fid)
+    with pytest.raises(ValueError, match=r"TipRelief\.amount"):
+        PAIR.replace(**{"tip_relief.amount": -50e-6})
+    scalar = eqx.tree_at(lambda p: p.tip_relief.amount, PAIR, 12e-6)
+    with pytest.raises(ValueError, match=r"TipRelief\.amount.*shape"):
+        jg.simulate(scalar, LUB, SURF, OP, fidelity=fid)
+    bad_mu = eqx.tree_at(lambda f: f.contact.constants.boundary_friction, fid, 3.0)
+    with pytest.raises(ValueError, match=r"Fidelity\.boundary_friction"):
+        jg.simulate(PAIR, LUB, SURF, OP, fidelity=bad_mu)
+    with pytest.raises(ValueError, match=r"Fidelity\.boundary_friction"):
+        fid.with_constants(boundary_friction=-0.1)
+    with pytest.raises(ValueError, match=r"OperatingPoint\.torque"):
+        jg.simulate(PAIR, LUB, SURF, eqx.tree_at(lambda o: o.torque, OP, -1.0), fidelity=fid)
+
+
+def test_a_failed_implicit_solve_gives_nan_derivatives_not_an_exception():
+    # y = a cos y, differentiated implicitly as the coupled model's fixed point is, with a GMRES
+    # allowed no Krylov vector at all: it cannot converge. optimistix's ImplicitAdjoint (lineax)
+    # raises from inside jax.jvp; the coupled model's adjoint gives a NaN tangent instead.
+    def solve(a, adjoint):
+        sol = optx.fixed_point(
+            lambda y, a: a * jnp.cos(y),
+            optx.FixedPointIteration(rtol=1e-12, atol=1e-12),
+            jnp.asarray(0.5),
+            args=a,
+            adjoint=adjoint,
+            max_steps=500,
+        )
+        return sol.value
+
+    failing = EarlyExitGMRES(rtol=1e-10, atol=0.0, max_restarts=0, nan_on_failure=True)
+    one = (jnp.asarray(0.5),), (jnp.ones(()),)
+    value, tangent = jax.jvp(lambda a: solve(a, NaNImplicitAdjoint(failing)), *one)
+    assert bool(jnp.isfinite(value)) and bool(jnp.isnan(tangent))
+    # a solve that converges gives the closed form y' = cos y / (1 + a sin y) (implicit
+    # differentiation of y − a cos y = 0), in forward and reverse mode
+    good = NaNImplicitAdjoint(EarlyExitGMRES(rtol=1e-12, atol=0.0, nan_on_failure=True))
+    value, tangent = jax.jvp(lambda a: solve(a, good), *one)
+    expected = float(jnp.cos(value) / (1.0 + 0.5 * jnp.sin(value)))
+    assert float(tangent) == pytest.approx(expected, rel=1e-9)
+    assert float(jax.grad(lambda a: solve(a, good))(0.5)) == pytest.approx(expected, rel=1e-9)
+    assert bool(jnp.isnan(jax.grad(lambda a: solve(a, NaNImplicitAdjoint(failing)))(0.5)))
+    plain = EarlyExitGMRES(rtol=1e-10, atol=0.0, max_restarts=0)
+    with pytest.raises(Exception, match="max_steps|maximum"):
+        jax.block_until_ready(
+            jax.jvp(lambda a: solve(a, optx.ImplicitAdjoint(linear_solver=plain)), *one)
+        )
