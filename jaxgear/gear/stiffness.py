@@ -49,6 +49,12 @@ def base_half_angle(pair: GearPair):
     return jnp.pi / (2.0 * z) + involute(a0) + 2.0 * pair.profile_shift * jnp.tan(a0) / z
 
 
+def _sqrt_positive(x):
+    """√max(x, 0) whose derivative is 0 where x ≤ 0 (the double where)."""
+    positive = x > 0.0
+    return jnp.where(positive, jnp.sqrt(jnp.where(positive, x, 1.0)), 0.0)
+
+
 def _gauss(f, lo, hi, nodes, weights):
     """∫_lo^hi f over the last axis, Gauss-Legendre (lo, hi broadcast with the leading shape)."""
     half = 0.5 * (hi - lo)
@@ -101,7 +107,8 @@ def tooth_compliances(pair: GearPair, gear: int, roll_angle):
         )
 
     # Involute part: from the base circle (or the root circle if it lies above) to the contact point.
-    t_low = jnp.sqrt(jnp.maximum(rf**2 - rb**2, 0.0)) / rb
+    # (0 when the root lies below the base circle; its derivative is then 0, not √'(0) × 0 = NaN.)
+    t_low = _sqrt_positive(rf**2 - rb**2) / rb
     t_lo = jnp.broadcast_to(t_low, eps.shape)
 
     def inv_integrand(k):
@@ -116,7 +123,7 @@ def tooth_compliances(pair: GearPair, gear: int, roll_angle):
     # Constant-thickness section between the root circle and the base circle (root below base).
     y_base = rb * jnp.sin(a2)
     x_base = rb * jnp.cos(a2)
-    x_root = jnp.sqrt(jnp.maximum(rf**2 - y_base**2, 0.0))
+    x_root = _sqrt_positive(rf**2 - y_base**2)
     x_root = jnp.minimum(x_root, x_base)
     x_lo = jnp.broadcast_to(x_root, eps.shape)
     x_hi = jnp.broadcast_to(x_base, eps.shape)
