@@ -122,3 +122,13 @@ def check_float64(name: str, value: Any) -> None:
             f"{name} has dtype {dtype}; jaxgear needs float64 here. Enable it with "
             "jax.config.update('jax_enable_x64', True) before creating arrays."
         )
+
+
+def check_shape(name: str, value: Any, shape: tuple[int, ...], what: str = "") -> None:
+    """Raise unless ``value`` has the array shape ``shape`` (checked on tracers too: shapes are
+    static). The message names the field, its shape and the valid shape, e.g.
+    ``TipRelief.amount has shape (); valid shape: (2,) (one value per gear)``."""
+    got = np.shape(value)
+    if got != tuple(shape):
+        note = f" ({what})" if what else ""
+        raise ValueError(f"{name} has shape {got}; valid shape: {tuple(shape)}{note}")

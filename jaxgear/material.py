@@ -6,11 +6,21 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from ._validation import check_positive, check_range
+from . import _inputs
+from ._validation import check_positive, check_range, check_shape
+
+_FIELDS = ("youngs_modulus", "poisson_ratio", "density", "thermal_conductivity", "specific_heat")
+
+
+def _float_array(value) -> Float[Array, "..."]:
+    return jnp.asarray(value, dtype=jnp.result_type(float))
 
 
 class Material(eqx.Module):
-    """Isotropic solid, SI units.
+    """Isotropic solid, SI units; every field a float64 scalar array.
+
+    Change a field with ``material.replace(youngs_modulus=210e9)`` (validated), not
+    ``eqx.tree_at``, which skips the checks (``jaxgear._inputs.validate`` re-runs them).
 
     Attributes:
         youngs_modulus: E, Pa.
@@ -20,13 +30,15 @@ class Material(eqx.Module):
         specific_heat: c, J/(kg K).
     """
 
-    youngs_modulus: Float[Array, ""] = eqx.field(converter=jnp.asarray)
-    poisson_ratio: Float[Array, ""] = eqx.field(converter=jnp.asarray)
-    density: Float[Array, ""] = eqx.field(converter=jnp.asarray)
-    thermal_conductivity: Float[Array, ""] = eqx.field(converter=jnp.asarray)
-    specific_heat: Float[Array, ""] = eqx.field(converter=jnp.asarray)
+    youngs_modulus: Float[Array, ""] = eqx.field(converter=_float_array)
+    poisson_ratio: Float[Array, ""] = eqx.field(converter=_float_array)
+    density: Float[Array, ""] = eqx.field(converter=_float_array)
+    thermal_conductivity: Float[Array, ""] = eqx.field(converter=_float_array)
+    specific_heat: Float[Array, ""] = eqx.field(converter=_float_array)
 
     def __check_init__(self):
+        for name in _FIELDS:
+            check_shape(f"Material.{name}", getattr(self, name), (), "a scalar")
         check_positive("Material.youngs_modulus", self.youngs_modulus, "Pa")
         check_range(
             "Material.poisson_ratio",
@@ -39,6 +51,13 @@ class Material(eqx.Module):
         check_positive("Material.density", self.density, "kg/m^3")
         check_positive("Material.thermal_conductivity", self.thermal_conductivity, "W/(m K)")
         check_positive("Material.specific_heat", self.specific_heat, "J/(kg K)")
+
+    def replace(self, **changes) -> Material:
+        """A validated copy with fields substituted (``jaxgear._inputs.replace``)."""
+        try:
+            return _inputs.replace(self, **changes)
+        except ValueError as err:
+            raise ValueError(f"Material.replace({', '.join(changes)}): {err}") from None
 
     @property
     def thermal_diffusivity(self) -> Float[Array, ""]:

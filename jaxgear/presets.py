@@ -14,22 +14,22 @@ from .material import steel as steel
 
 
 def li2015_pair(tip_relief: float = 10e-6, relief_start_deg: float = 20.9) -> GearPair:
-    """The paper's spur gear pair (REFERENCE §2): 50/50 teeth, m 3 mm, 20°, face 20 mm,
-    tip/root diameter 156/140 mm, centre distance 150 mm, backlash 0.14 mm, the paper's bearings,
+    """The paper's spur gear pair (REFERENCE §2) by its basic rack: 50/50 teeth, m 3 mm, 20°,
+    h_a* = 1, h_f* = 5/3, no profile shift, face 20 mm, backlash 0.14 mm, the paper's bearings,
     linear tip relief of ``tip_relief`` metres on both gears from roll angle ``relief_start_deg``.
 
-    Blanks default to solid steel disks (the paper does not give masses); see
-    ``li2015_pair_calibrated`` for the preset tuned to the paper's resonance speeds.
+    The tip and root diameters 156/140 mm and the centre distance 150 mm are derived from these
+    (to round-off), so a changed module or pressure angle gives a consistent pair. Blanks default to
+    solid steel disks (the paper does not give masses); see ``li2015_pair_calibrated`` for the preset
+    tuned to the paper's resonance speeds.
     """
-    m = 3.0e-3
     return GearPair(
         teeth=(50, 50),
-        module=m,
+        module=3.0e-3,
         pressure_angle=math.radians(20.0),
         face_width=0.020,
-        tip_radius=0.078,
-        root_radius=0.070,
-        centre_distance=0.150,
+        addendum_coefficient=1.0,
+        dedendum_coefficient=5.0 / 3.0,  # root diameter 140 mm = m (z − 2 h_f*)
         backlash=0.14e-3,
         bearings=Bearings(ky=1.15e9, cy=5360.0, kx=8.0e8, cx=2980.0, ct=10.0),
         tip_relief=TipRelief(
@@ -56,10 +56,6 @@ def li2015_pair_calibrated(tip_relief: float = 10e-6, relief_start_deg: float = 
     larger, around 3500 rpm, as in the paper. The mesh stiffness is not scaled. How and why (and the
     alternative two-mode reading, which the model does not support): notebooks/calibration.ipynb.
     """
-    import equinox as eqx
-    import jax.numpy as jnp
-
-    pair = li2015_pair(tip_relief=tip_relief, relief_start_deg=relief_start_deg)
-    mass = jnp.full(2, LI2015_CALIBRATED_BLANK_MASS)
-    inertia = jnp.full(2, LI2015_CALIBRATED_BLANK_INERTIA)
-    return eqx.tree_at(lambda p: (p.blank_mass, p.blank_inertia), pair, (mass, inertia))
+    return li2015_pair(tip_relief=tip_relief, relief_start_deg=relief_start_deg).replace(
+        blank_mass=LI2015_CALIBRATED_BLANK_MASS, blank_inertia=LI2015_CALIBRATED_BLANK_INERTIA
+    )

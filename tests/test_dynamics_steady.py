@@ -182,8 +182,10 @@ def test_bad_input_raises_value_error_naming_the_field():
         )
     with pytest.raises(ValueError, match="mesh_stiffness"):
         jg.natural_frequencies(pair, -3e8)
-    # A pair whose masses were made invalid after construction is still caught at the boundary.
-    bad = eqx.tree_at(lambda p: p.blank_mass, pair, jnp.asarray([2.0, -2.0]))
+    # A pair whose masses were made invalid after construction is still caught at the boundary
+    # (blank_mass is derived unless given: a given one is stored in blank_mass_override).
+    calibrated = jg.presets.li2015_pair_calibrated()
+    bad = eqx.tree_at(lambda p: p.blank_mass_override, calibrated, jnp.asarray([2.0, -2.0]))
     with pytest.raises(ValueError, match="blank_mass"):
         jg.dynamic_response(bad, jg.OperatingPoint(torque=700.0, speed_rpm=1000.0))
     with pytest.raises(ValueError, match="DynamicsOptions.backlash"):

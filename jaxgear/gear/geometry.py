@@ -14,6 +14,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from .._validation import check_instance
+from . import involute as inv
 from .pair import GearPair
 
 
@@ -50,27 +51,21 @@ class GearGeometry(eqx.Module):
 
 
 def gear_geometry(pair: GearPair) -> GearGeometry:
-    """Geometry of ``pair`` (differentiable in every traced field)."""
+    """Geometry of ``pair`` (differentiable in every traced field; formulas in ``gear/involute.py``)."""
     check_instance("pair", pair, GearPair)
-    z = jnp.asarray(pair.teeth, dtype=float)
-    r_ref = pair.module * z / 2.0
-    rb = r_ref * jnp.cos(pair.pressure_angle)
+    rb = pair.base_radius
     a_w = pair.centre_distance
-    cos_aw = (rb[0] + rb[1]) / a_w
-    alpha_w = jnp.arccos(cos_aw)
-    r_w = rb / cos_aw
-    t1t2 = a_w * jnp.sin(alpha_w)
-    pb = 2.0 * jnp.pi * rb[0] / z[0]
     ra = pair.tip_radius
-    s_end = jnp.sqrt(ra[0] ** 2 - rb[0] ** 2)
-    s_start = t1t2 - jnp.sqrt(ra[1] ** 2 - rb[1] ** 2)
+    cos_aw = (rb[0] + rb[1]) / a_w
+    alpha_w = inv.operating_pressure_angle(rb, a_w)
+    t1t2, s_start, s_end = inv.path_of_contact(rb, ra, a_w)
+    pb = inv.base_pitch(rb[0], pair.teeth[0])
     path = s_end - s_start
-    eps_tip = jnp.sqrt(ra**2 - rb**2) / rb
     eps_sap = jnp.stack([s_start / rb[0], (t1t2 - s_end) / rb[1]])
     return GearGeometry(
         base_radius=rb,
-        reference_pitch_radius=r_ref,
-        pitch_radius=r_w,
+        reference_pitch_radius=pair.reference_radius,
+        pitch_radius=rb / cos_aw,
         tip_radius=ra,
         root_radius=pair.root_radius,
         centre_distance=a_w,
@@ -87,7 +82,7 @@ def gear_geometry(pair: GearPair) -> GearGeometry:
         roll_angle_highest_single=(s_start + pb) / rb[0],
         roll_angle_end=s_end / rb[0],
         roll_angle_start_active=eps_sap,
-        roll_angle_tip=eps_tip,
+        roll_angle_tip=inv.roll_angle(ra, rb),
     )
 
 
@@ -172,5 +167,4 @@ def hertz_pressure(load_per_width, reduced_radius, e_reduced):
 
 def normal_load(pair: GearPair, torque):
     """Total normal tooth load W = T1/rb1, N (gear 1 torque T1 in N m)."""
-    rb1 = pair.module * pair.teeth[0] / 2.0 * jnp.cos(pair.pressure_angle)
-    return torque / rb1
+    return torque / pair.base_radius[0]

@@ -10,9 +10,10 @@ from jaxtyping import Array, Float
 from .._validation import check_instance, check_positive, check_range
 from ..material import reduced_modulus
 from .geometry import GearGeometry, gear_geometry, normal_load, radii_of_curvature
+from .involute import involute, reference_tooth_thickness
 from .load_sharing import DEFAULT_CONTACT_SMOOTHING, share_load
 from .modification import DEFAULT_RELIEF_SMOOTHING, relief_separation
-from .pair import GearPair, involute
+from .pair import GearPair
 from .stiffness import STIFFNESS_METHODS, pair_stiffness
 
 #: Tip edge rounding, as a fraction of the base pitch (``mesh_cycle``'s ``edge_width``).
@@ -188,7 +189,7 @@ def back_flank_phase(pair: GearPair, tau):
     geo = gear_geometry(pair)
     alpha, alpha_w = pair.pressure_angle, geo.operating_pressure_angle
     rb1, r_ref1 = geo.base_radius[0], geo.reference_pitch_radius[0]
-    thickness = pair.module * (jnp.pi / 2.0 + 2.0 * pair.profile_shift[0] * jnp.tan(alpha))
+    thickness = reference_tooth_thickness(pair.module, alpha, pair.profile_shift[0])
     both = rb1 * (2.0 * alpha_w + 2.0 * involute(alpha) + thickness / r_ref1)
     c = (both - 2.0 * geo.path_start) / geo.base_pitch
     return jnp.mod(c - tau, 1.0)

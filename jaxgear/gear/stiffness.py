@@ -22,10 +22,13 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..material import reduced_modulus
+from . import involute as inv
 from .geometry import GearGeometry, roll_angles
-from .pair import GearPair, involute
+from .pair import GearPair
 
 STIFFNESS_METHODS = ("potential_energy", "iso")
+#: h_fP/m of ISO 53's standard basic rack profile, the default of ``iso_single_stiffness``.
+ISO_BASIC_RACK_DEDENDUM = 1.25
 
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(24)
 _GL8_NODES, _GL8_WEIGHTS = np.polynomial.legendre.leggauss(8)
@@ -44,9 +47,13 @@ _SAINSOT = np.array(
 
 def base_half_angle(pair: GearPair):
     """α2 per gear: half the tooth angle at the base circle, rad (shape (2,))."""
-    z = jnp.asarray(pair.teeth, dtype=float)
-    a0 = pair.pressure_angle
-    return jnp.pi / (2.0 * z) + involute(a0) + 2.0 * pair.profile_shift * jnp.tan(a0) / z
+    return inv.base_half_angle(pair.teeth, pair.pressure_angle, pair.profile_shift)
+
+
+def _sqrt_positive(x):
+    """√max(x, 0) whose derivative is 0 where x ≤ 0 (the double where)."""
+    positive = x > 0.0
+    return jnp.where(positive, jnp.sqrt(jnp.where(positive, x, 1.0)), 0.0)
 
 
 def _gauss(f, lo, hi, nodes, weights):
@@ -67,8 +74,7 @@ def tooth_compliances(pair: GearPair, gear: int, roll_angle):
     e_mod = mat.youngs_modulus
     g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
     width = pair.face_width
-    z = pair.teeth[gear]
-    rb = pair.module * z / 2.0 * jnp.cos(pair.pressure_angle)
+    rb = pair.base_radius[gear]
     rf = pair.root_radius[gear]
     a2 = base_half_angle(pair)[gear]
     eps = jnp.asarray(roll_angle)
@@ -101,7 +107,8 @@ def tooth_compliances(pair: GearPair, gear: int, roll_angle):
         )
 
     # Involute part: from the base circle (or the root circle if it lies above) to the contact point.
-    t_low = jnp.sqrt(jnp.maximum(rf**2 - rb**2, 0.0)) / rb
+    # (0 when the root lies below the base circle; its derivative is then 0, not √'(0) × 0 = NaN.)
+    t_low = inv.roll_angle(rf, rb)
     t_lo = jnp.broadcast_to(t_low, eps.shape)
 
     def inv_integrand(k):
@@ -116,7 +123,7 @@ def tooth_compliances(pair: GearPair, gear: int, roll_angle):
     # Constant-thickness section between the root circle and the base circle (root below base).
     y_base = rb * jnp.sin(a2)
     x_base = rb * jnp.cos(a2)
-    x_root = jnp.sqrt(jnp.maximum(rf**2 - y_base**2, 0.0))
+    x_root = _sqrt_positive(rf**2 - y_base**2)
     x_root = jnp.minimum(x_root, x_base)
     x_lo = jnp.broadcast_to(x_root, eps.shape)
     x_hi = jnp.broadcast_to(x_base, eps.shape)
@@ -158,11 +165,16 @@ def hertz_contact_stiffness(pair: GearPair):
     return jnp.pi * e_red * pair.face_width / 4.0
 
 
-def iso_single_stiffness(pair: GearPair):
+def iso_single_stiffness(pair: GearPair, basic_rack_dedendum=ISO_BASIC_RACK_DEDENDUM):
     """ISO 6336-1 method B single stiffness c' per unit face width (N/m per m, i.e. Pa).
 
     c' = c'_th C_M C_R C_B with c'_th = 1/q' (solid disks C_R = 1, C_M = 0.8,
     C_B = [1 + 0.5(1.2 − h_fP/m)][1 − 0.02(20° − α)], h_fP/m clipped to ISO's 1.2-1.4).
+
+    ``basic_rack_dedendum`` is h_fP/m of the basic rack profile the rating refers to (default ISO
+    53's 1.25). It is not the pair's ``dedendum_coefficient``, which places the root circle: the
+    cutting tool may take the root deeper than the basic rack (the paper's pair: h_f* = 5/3), a depth
+    the potential-energy method models and ISO's factor does not.
     """
     zn1, zn2 = float(pair.teeth[0]), float(pair.teeth[1])
     x1, x2 = pair.profile_shift[0], pair.profile_shift[1]
@@ -178,7 +190,7 @@ def iso_single_stiffness(pair: GearPair):
         + 0.00182 * x2**2
     )  # mm µm / N
     c_th = 1.0 / q  # N / (mm µm)
-    hfp = jnp.clip(pair.dedendum_coefficient, 1.2, 1.4)
+    hfp = jnp.clip(basic_rack_dedendum, 1.2, 1.4)
     c_b = (1.0 + 0.5 * (1.2 - hfp)) * (1.0 - 0.02 * (20.0 - jnp.degrees(pair.pressure_angle)))
     c_prime = c_th * 0.8 * 1.0 * c_b
     return c_prime * 1e9  # N/(mm µm) = 1e9 N/m²
