@@ -89,6 +89,13 @@ def _implicit_jvp(primals, tangents):
         ).value
 
     _, rhs = jax.jvp(rewrite_of, (diff,), (t_inputs,))
+    # Parts of the right-hand side that no input tangent reaches (the state's non-differentiated
+    # parts) come out as constant zeros; custom_linear_solve transposes only a right-hand side
+    # that is linear throughout, so each leaf gets a zero that is (0 × the sum of the others).
+    leaves = jtu.tree_leaves(rhs)
+    if leaves:
+        anchor = 0.0 * sum(jnp.sum(leaf) for leaf in leaves)
+        rhs = jtu.tree_map(lambda leaf: leaf + anchor.astype(leaf.dtype), rhs)
     # custom_linear_solve: JAX transposes it by solving with the transposed operator (the same
     # solver), where lineax's own transpose would raise on a failed solve
     t_root = jtu.tree_map(

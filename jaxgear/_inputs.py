@@ -17,6 +17,7 @@ per value, no derivative), and a bad value would go unchecked. So:
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import equinox as eqx
@@ -79,8 +80,6 @@ def _modules(tree):
 
 
 def _field_names(module) -> list[str]:
-    import dataclasses
-
     return [f.name for f in dataclasses.fields(module)]
 
 
@@ -131,8 +130,9 @@ def replace(obj, **changes: Any):
                 f"{', '.join(_field_names(obj))}"
             ) from None
         new = value
-        if _is_float_like(value) or isinstance(value, list | tuple):
-            new = jnp.asarray(value, dtype=_float_dtype()) if not _is_module(value) else value
+        numbers = isinstance(value, list | tuple) and not any(map(_is_module, value))
+        if _is_float_like(value) or numbers:
+            new = jnp.asarray(value, dtype=_float_dtype())
             old_shape = jnp.shape(old) if _is_float_like(old) else None
             if old_shape is not None and new.shape != old_shape:
                 if new.shape == ():

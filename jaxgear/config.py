@@ -158,24 +158,19 @@ def gear_pair_from_config(cfg: dict[str, Any], default_preset: str = "li2015") -
             module=base.module,
             pressure_angle=base.pressure_angle,
             face_width=base.face_width,
-            tip_radius=base.tip_radius,
-            root_radius=base.root_radius,
-            centre_distance=base.centre_distance,
+            profile_shift=base.profile_shift,
+            addendum_coefficient=base.addendum_coefficient,
+            dedendum_coefficient=base.dedendum_coefficient,
             backlash=base.backlash,
             bearings=base.bearings,
             tip_relief=base.tip_relief,
         )
         if preset == "li2015_calibrated":
             kwargs.update(blank_mass=base.blank_mass, blank_inertia=base.blank_inertia)
-        # Changing the basic geometry invalidates the preset's explicit radii and centre distance.
+        # The preset's radii and centre distance follow from its coefficients (so from a new
+        # module or shift too); its calibrated blanks belong to its own geometry.
         if any(k in gear for k in ("teeth", "module_mm", "pressure_angle_deg", "profile_shift")):
-            for k in (
-                "tip_radius",
-                "root_radius",
-                "centre_distance",
-                "blank_mass",
-                "blank_inertia",
-            ):
+            for k in ("blank_mass", "blank_inertia"):
                 kwargs.pop(k, None)
     else:
         for required in ("teeth", "module_mm", "pressure_angle_deg", "face_width_mm"):

@@ -17,7 +17,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._inputs import canonical, validate
+from ._validation import check_non_negative, check_positive, check_range
 from .fidelity import Fidelity
+from .gear.pair import MAX_RELIEF_PER_MODULE
 from .operating import OperatingPoint
 from .sweep_engine import STATUS_NAMES as POINT_STATUS_NAMES
 from .sweep_engine import run_continuation, run_points
@@ -380,9 +382,6 @@ def sweep(
 
 def _validate_points(pair, surfaces, op, inputs):
     """Every point must be a valid operating point: check them all before any work starts."""
-    from ._validation import check_non_negative, check_positive, check_range
-    from .gear.pair import MAX_RELIEF_PER_MODULE
-
     if "speed_rpm" in inputs:
         check_positive("speeds_rpm", inputs["speed_rpm"], "rpm")
     if "torque" in inputs:

@@ -82,6 +82,8 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from .._validation import check_finite, check_integer, check_non_negative, check_positive
+from ..gear.geometry import gear_geometry
+from ..gear.mesh import back_flank_phase
 
 BacklashKind = Literal["exact", "smooth"]
 BACKLASH_KINDS = ("exact", "smooth")
@@ -505,15 +507,11 @@ def build_dynamics(
     pair, op, mesh, interface: MeshInterface, options: DynamicsOptions
 ) -> GearDynamics:
     """Assemble Eq. (1)'s parameters from the gear pair, operating point, mesh cycle and interface."""
-    from ..gear.geometry import gear_geometry
-
     if interface.n_positions != mesh.n_positions:
         raise ValueError(
             f"MeshInterface has {interface.n_positions} positions but the MeshCycle has "
             f"{mesh.n_positions}; they must match"
         )
-    from ..gear.mesh import back_flank_phase
-
     geo = gear_geometry(pair)
     rb = geo.base_radius
     z1, z2 = pair.teeth

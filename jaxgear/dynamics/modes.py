@@ -13,6 +13,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, Float
 
 from .._validation import check_instance, check_positive
+from ..gear.geometry import gear_geometry
 from ..gear.pair import GearPair
 
 
@@ -32,8 +33,6 @@ class Modes(eqx.Module):
 
 
 def _matrices(pair, mesh_stiffness):
-    from ..gear.geometry import gear_geometry
-
     rb = gear_geometry(pair).base_radius
     m, j, b = pair.blank_mass, pair.blank_inertia, pair.bearings
     mass = jnp.stack([j[0], m[0], m[0], j[1], m[1], m[1]])
