@@ -489,7 +489,7 @@ def field_surfaces(kind: str, short_cutoff: float | None = FIELD_SHORT_CUTOFF):
 
 def _solve_contact(repro, result, index, i, slot, label, deterministic=False):
     """(EHLSolution, description, thermal) of one tooth contact of ``result``."""
-    from .lubrication.contacts import ehl_model_of
+    from .contact.ehl import ehl_model_of
     from .lubrication.ehl import EHLModel, solve_ehl
 
     fid = repro.fidelity

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import jaxgear as jg
-from jaxgear.lubrication.contacts import _patch_failed
+from jaxgear.contact.coefficients import patch_failed as _patch_failed
 
 jax.config.update("jax_enable_x64", True)
 

@@ -238,7 +238,7 @@ def test_slivers_of_load_at_the_relief_edge_carry_nothing():
     # extremes matrix). The closed forms have no meaning there (unbounded film, 0/0 in the asperity
     # share); the rung counts a slot as loaded above 1e-4 of the total load, as the EHL rungs do.
     from jaxgear.contact import formula_ehl_contact_forces, kinematic_velocities
-    from jaxgear.lubrication.contacts import LOADED_SHARE
+    from jaxgear.contact.base import LOADED_SHARE
 
     pair = jg.presets.li2015_pair_calibrated()
     mesh = jg.mesh_cycle(pair, torque=700.0, n_positions=8)

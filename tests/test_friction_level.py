@@ -17,7 +17,7 @@ from ehl_cases import gear_contact, greenwood_tripp_pressure
 
 import jaxgear as jg
 from jaxgear.config import fidelity_from_config, sweep_from_config
-from jaxgear.lubrication.contacts import ehl_model_of
+from jaxgear.contact.ehl import ehl_model_of
 
 LUB = jg.presets.mil_l_23699()
 RANGES = {"asperity_density_product": "[0.0001, 1]", "asperity_slope_ratio": "[1e-06, 1]"}

@@ -12,9 +12,10 @@ import pytest
 
 import jaxgear as jg
 from jaxgear.contact import kinematic_velocities
+from jaxgear.contact.ehl import ehl_contact_forces
+from jaxgear.contact.frozen import frozen_contact_forces
 from jaxgear.fidelity import Fidelity
 from jaxgear.gear.geometry import mesh_period
-from jaxgear.lubrication.contacts import ehl_contact_forces, frozen_contact_forces
 from jaxgear.tribodynamics import simulate
 
 

@@ -7,7 +7,7 @@ import pytest
 
 import jaxgear as jg
 from jaxgear.config import fidelity_from_config
-from jaxgear.lubrication.contacts import ehl_model_of
+from jaxgear.contact.ehl import ehl_model_of
 
 PAIR = jg.presets.li2015_pair_calibrated()
 LUB = jg.presets.mil_l_23699()

@@ -12,9 +12,9 @@ import pytest
 
 import jaxgear as jg
 from jaxgear.contact import kinematic_velocities
+from jaxgear.contact.ehl import ehl_contact_forces
 from jaxgear.gear.geometry import mesh_period
 from jaxgear.gear.mesh import mesh_cycle
-from jaxgear.lubrication.contacts import ehl_contact_forces
 
 jax.config.update("jax_enable_x64", True)
 

@@ -248,7 +248,7 @@ def test_ehl_contact_forces_have_finite_tangents_on_unloaded_slots(setup):
     # made every tribo-dynamic EHL gradient NaN. Every tangent must be finite, zero where masked,
     # and equal to central differences where loaded.
     from jaxgear.contact import kinematic_velocities
-    from jaxgear.lubrication.contacts import ehl_contact_forces
+    from jaxgear.contact.ehl import ehl_contact_forces
 
     pair, lub, surf = setup
     fid = Fidelity(dynamics="quasi_static", friction="ehl_smooth", n_positions=24, n_nodes=65)

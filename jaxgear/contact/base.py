@@ -23,6 +23,11 @@ from ..gear.pair import GearPair
 # next).
 SIGN_SLIDE_TO_ROLL = 0.02
 
+#: A slot counts as loaded above this share of the total load (below it the contact is a
+#: few-newton touch at the edge of relief, where EHL has no meaning and contributes nothing
+#: measurable).
+LOADED_SHARE = 1e-4
+
 
 class ContactForces(eqx.Module):
     """What the contacts of one mesh cycle give back, per [position, pair] (SI).
@@ -36,7 +41,7 @@ class ContactForces(eqx.Module):
         friction_coefficient: (Fs² + Fr²)^½ / W_T where loaded (informative), dimensionless.
         converged: every contact solve converged.
         failed: number of loaded contacts whose solve failed (their outputs are carried over from
-            the nearest good contact; see ``contacts._patch_failed``).
+            the nearest good contact; see ``contact.coefficients.patch_failed``).
     """
 
     friction_sliding: Float[Array, "M 2"]
@@ -69,5 +74,3 @@ def kinematic_velocities(pair: GearPair, mesh: MeshCycle, omega1):
     """Kinematic surface velocities uj = ρj ωj per [position, pair, gear], m/s."""
     omega = jnp.stack([omega1, omega1 * pair.teeth[0] / pair.teeth[1]])
     return mesh.radius_of_curvature * omega
-
-

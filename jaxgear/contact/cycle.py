@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..lubrication.contacts import ehl_contact_forces
+from .ehl import ehl_contact_forces
 from .formula import formula_contact_forces, formula_ehl_contact_forces
 
 

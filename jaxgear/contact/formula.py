@@ -13,12 +13,7 @@ from ..gear.pair import GearPair
 from ..lubrication.ehl_formula import ehl_formula_contact
 from ..lubrication.friction_models import XuFriction, smooth_sign
 from ..material import reduced_modulus
-from .base import SIGN_SLIDE_TO_ROLL, ContactForces, safe_sqrt
-
-#: A slot counts as loaded above this share of the total load (below it the contact is a
-#: few-newton touch at the edge of relief, where EHL has no meaning and contributes nothing
-#: measurable).
-LOADED_SHARE = 1e-4
+from .base import LOADED_SHARE, SIGN_SLIDE_TO_ROLL, ContactForces, safe_sqrt
 
 
 def formula_contact_forces(
@@ -124,5 +119,3 @@ def formula_ehl_contact_forces(
         converged=jnp.asarray(True),
         failed=jnp.asarray(0, dtype=jnp.int32),
     )
-
-

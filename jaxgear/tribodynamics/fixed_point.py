@@ -26,11 +26,11 @@ from .._krylov import EarlyExitGMRES
 from ..anderson import Anderson
 from ..contact.base import ContactForces, interface_from_forces, kinematic_velocities
 from ..contact.cycle import contact_forces
+from ..contact.frozen import frozen_contact_forces
 from ..dynamics.model import DynamicsOptions, MeshInterface
 from ..dynamics.response import steady_state
 from ..gear.geometry import mesh_period
 from ..gear.mesh import MeshCycle
-from ..lubrication.contacts import frozen_contact_forces
 from .result import (
     STATUS_CONTACT,
     STATUS_DYNAMICS,
@@ -182,7 +182,7 @@ def tribo_dynamic_fixed_point(pair, lubricant, surfaces, op, fidelity, mesh, war
         # A shooting that diverged (NaN orbit) must not poison the tables: the contacts keep the
         # last finite loads and velocities, and the next iteration shoots cold. (Seen at 3400 rpm at
         # the paper fidelity, where NaN contact outputs made the shooting diverge; those are now
-        # kept finite at their source, contacts.ehl_contact_forces. This is the second guard.)
+        # kept finite at their source, contact.ehl.ehl_contact_forces. This is the second guard.)
         finite = (
             jnp.all(jnp.isfinite(resp.initial_state))
             & jnp.all(jnp.isfinite(resp.tooth_force))
