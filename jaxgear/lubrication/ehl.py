@@ -137,8 +137,31 @@ class LineContact(eqx.Module):
         return hertz_pressure(self.load_per_width, self.reduced_radius, self.e_reduced)
 
 
+def _float64(value):
+    """A model constant as a float64 array (a Python float would be a static leaf: one compilation
+    per value, and no derivative)."""
+    if isinstance(value, bool | str):
+        raise ValueError(f"{value!r} is not valid; valid: a real number")
+    return jnp.asarray(value, dtype=jnp.result_type(float))
+
+
+def _float64_or_none(value):
+    return None if value is None else _float64(value)
+
+
+#: EHLModel's physical constants: traced numbers (every other field is a static choice)
+MODEL_NUMBERS = (
+    "boundary_friction",
+    "asperity_density_product",
+    "asperity_slope_ratio",
+    "limiting_shear_coefficient",
+)
+
+
 class EHLModel(eqx.Module):
-    """Static configuration of ``solve_ehl`` (hashable; changing it recompiles).
+    """Configuration of ``solve_ehl``: static choices (changing one recompiles) and the contact's
+    physical constants ``MODEL_NUMBERS`` (μb, nβσ, σ/β, Λ: float64 arrays, traced: changing one
+    never recompiles, and the solution can be differentiated with respect to each).
 
     Attributes:
         n_nodes: grid nodes N; (N − 1) should hold a power of 2 for grid sequencing.
@@ -335,14 +358,16 @@ class EHLModel(eqx.Module):
     thermal_iterations: int | None = eqx.field(static=True, default=None)
     thermal_rtol: float = eqx.field(static=True, default=0.01)
     thermal_atol: float = eqx.field(static=True, default=0.05)
-    boundary_friction: float = eqx.field(static=True, default=0.1)
+    boundary_friction: Float[Array, ""] = eqx.field(converter=_float64, default=0.1)
     contact_threshold: float = eqx.field(static=True, default=5e-3)
     roughness_steps: int = eqx.field(static=True, default=8)
     mixed: str = eqx.field(static=True, default="deterministic")
-    asperity_density_product: float = eqx.field(static=True, default=0.05)
-    asperity_slope_ratio: float = eqx.field(static=True, default=0.01)
+    asperity_density_product: Float[Array, ""] = eqx.field(converter=_float64, default=0.05)
+    asperity_slope_ratio: Float[Array, ""] = eqx.field(converter=_float64, default=0.01)
     asperity_relaxation: float = eqx.field(static=True, default=0.5)
-    limiting_shear_coefficient: float | None = eqx.field(static=True, default=None)
+    limiting_shear_coefficient: Float[Array, ""] | None = eqx.field(
+        converter=_float64_or_none, default=None
+    )
     relaxation_sweeps: int | None = eqx.field(static=True, default=None)
     pseudo_transient_steps: int = eqx.field(static=True, default=64)
     temperature_steps: int = eqx.field(static=True, default=2)
@@ -546,6 +571,36 @@ class EHLSolution(eqx.Module):
         return self.density * self.h
 
 
+class _Numbers(eqx.Module):
+    """EHLModel's physical constants, carried with the inputs (the θ of the implicit derivative)
+    while the static rest of the model selects the program."""
+
+    boundary_friction: Float[Array, ""]
+    asperity_density_product: Float[Array, ""]
+    asperity_slope_ratio: Float[Array, ""]
+    limiting_shear_coefficient: Float[Array, ""]  # read only where the model's cap is on
+
+
+def _split_numbers(model: EHLModel) -> tuple[_Numbers, EHLModel]:
+    """(the model's numbers, the model with them taken out): the second is hashable, a static
+    argument of the solver's programs; its ``limiting_shear_coefficient`` is True where the cap is
+    on and None where it is off."""
+    cap = model.limiting_shear_coefficient
+    numbers = _Numbers(
+        model.boundary_friction,
+        model.asperity_density_product,
+        model.asperity_slope_ratio,
+        jnp.zeros((), dtype=jnp.result_type(float)) if cap is None else cap,
+    )
+    fields = ("boundary_friction", "asperity_density_product", "asperity_slope_ratio")
+    static = eqx.tree_at(
+        lambda m: tuple(getattr(m, f) for f in fields), model, replace=(None,) * len(fields)
+    )
+    if cap is not None:
+        static = eqx.tree_at(lambda m: m.limiting_shear_coefficient, static, replace=True)
+    return numbers, static
+
+
 class _Inputs(eqx.Module):
     """Every continuous input of a solve (the θ of the implicit differentiation)."""
 
@@ -557,6 +612,7 @@ class _Inputs(eqx.Module):
     temperature_rise: Float[Array, " N"]  # K, mean film temperature above the inlet, at the nodes
     asperity_pressure: Float[Array, " N"]  # Pa, statistical asperity pressure at the nodes
     roughness: Float[Array, ""]  # m, composite roughness σ (statistical mixed model)
+    numbers: _Numbers  # the model's physical constants (``MODEL_NUMBERS``), traced
     # m, the film offset with the roughness where it stood at the previous time step (transient
     # deterministic passage steps: a start generator, see ``_half_step_start``; None: none)
     film_offset_previous: Float[Array, " N"] | None = None
@@ -1967,7 +2023,7 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     if model.limiting_shear_coefficient is not None:  # τ ≤ τL = Λ p (smooth); not the damping
         log_rate = jnp.log(abs_us / h_eff)
         log_tau = rheology.log_limited_stress(
-            log_eta_s + log_rate, p_dim, model.limiting_shear_coefficient, 1e-6 * sc.ph
+            log_eta_s + log_rate, p_dim, inp.numbers.limiting_shear_coefficient, 1e-6 * sc.ph
         )
         log_eta_s = log_tau - log_rate
     eta_s = jnp.exp(log_eta_s)
@@ -1987,7 +2043,9 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     fill = jnp.where(x > 0.0, jnp.clip(q / (sc.um * rho_h), 0.0, 1.0), 1.0)
     weights = jnp.full((n,), dx).at[0].set(0.5 * dx).at[-1].set(0.5 * dx)
     q_slide = fluid * fill * eta_s * sc.us**2 / h_eff  # paper Eq. (12), sliding part
-    q_asp = model.boundary_friction * (contact * p_dim + p_asp) * abs_us  # paper Eq. (12), h = 0
+    q_asp = (
+        inp.numbers.boundary_friction * (contact * p_dim + p_asp) * abs_us
+    )  # paper Eq. (12), h = 0
     # Poiseuille terms on cell faces, as the Reynolds discretisation has them (flow coefficient
     # averaged to the face, pressure gradient by the face difference)
     flow = fluid * h_eff**3 / (12.0 * eta_t)
@@ -1997,7 +2055,7 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     sign = (c.u2 - c.u1) / abs_us
     # paper Eq. (15): Fs = Σ μb p (asperity) + Σ η*(u2 − u1)/h (fluid); Fr = Σ (h/2) ∂p/∂x (fluid)
     fs_fluid = jnp.sum(weights * fluid * fill * eta_s * (c.u2 - c.u1) / h_eff)
-    fs_asp = jnp.sum(weights * model.boundary_friction * (contact * p_dim + p_asp)) * sign
+    fs_asp = jnp.sum(weights * inp.numbers.boundary_friction * (contact * p_dim + p_asp)) * sign
     h_face = 0.5 * (h[1:] + h[:-1]) * 0.5 * (fluid[1:] + fluid[:-1])
     fr = jnp.sum(0.5 * h_face * jnp.diff(p_dim))
     cm = jnp.sum(weights * fluid * fill * eta_t / h_eff)  # paper Eq. (13) per unit width
@@ -2018,7 +2076,9 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     t_in = jnp.broadcast_to(c.inlet_temperature, t.shape)
     if mixed == "statistical":
         area = asperity_mod.contact_area_ratio(
-            jnp.maximum(h, 0.0) + jnp.minimum(h, 0.0), inp.roughness, model.asperity_density_product
+            jnp.maximum(h, 0.0) + jnp.minimum(h, 0.0),
+            inp.roughness,
+            inp.numbers.asperity_density_product,
         )
         fraction = jnp.sum(hertz_zone * area) / jnp.sum(hertz_zone)
     else:
@@ -2133,8 +2193,8 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
             sol.h,
             inp_k.roughness,
             inp_k.contact.e_reduced,
-            model.asperity_density_product,
-            model.asperity_slope_ratio,
+            inp_k.numbers.asperity_density_product,
+            inp_k.numbers.asperity_slope_ratio,
         )
 
     def thermal_settled(change, rise):
@@ -2443,6 +2503,7 @@ def _solve_entry(
     solids,
     temperature_rise,
 ):
+    numbers, model = _split_numbers(model)
     n = model.n_nodes
     dtype = jnp.result_type(float)
     x_here = _grid_positions(model, contact, lubricant)
@@ -2479,7 +2540,7 @@ def _solve_entry(
     seed = z
     if mixed == "statistical" and initial is not None:
         seed = jnp.interp(x_here, initial.x, initial.asperity_pressure)
-    inp = _Inputs(contact, lubricant, rho_h_prev, inv_dt, offset, rise, seed, sigma)
+    inp = _Inputs(contact, lubricant, rho_h_prev, inv_dt, offset, rise, seed, sigma, numbers)
     if initial is not None:
         args = _warm_args(initial, mixed == "deterministic", moved=previous is not None)
         return _solve_impl(model, True, mixed, inp, *args, solids)[0]
@@ -2491,7 +2552,11 @@ def _grid_positions(model: EHLModel, contact: LineContact, lubricant: Lubricant)
     """Node positions x (m) of ``solve_ehl``'s fine grid for this contact."""
     n = model.n_nodes
     z = jnp.zeros((n,))
-    inp = _Inputs(contact, lubricant, z, jnp.zeros(()), z, z, z, jnp.zeros(()))
+    if model.boundary_friction is not None:  # a full model: its static part selects the grid
+        _, model = _split_numbers(model)
+    zero = jnp.zeros(())
+    numbers = _Numbers(zero, zero, zero, zero)  # the grid does not depend on them
+    inp = _Inputs(contact, lubricant, z, zero, z, z, z, zero, numbers)
     sc = _scales(model, inp)
     x, _ = _grid(sc, n)
     return x * sc.b

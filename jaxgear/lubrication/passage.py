@@ -46,6 +46,7 @@ from .ehl import (
     _Inputs,
     _roughness_offset,
     _solve_impl,
+    _split_numbers,
     _warm_args,
     transport_shift,
 )
@@ -206,7 +207,7 @@ def _runs_in(model: EHLModel, mixed: str) -> bool:
     return model.hardness is not None and mixed == "deterministic"
 
 
-def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, first):
+def _step(model, numbers, mixed, lubricant, surfaces, solids, depth, carry, contact, t, first):
     prev, temp1, temp2, d, t_prev, u_prev, older, older_ok, worn = carry
     # under a pressure limit the surfaces carried from the previous steps (run in), else the given
     surfaces = surfaces if worn is None else worn
@@ -283,6 +284,7 @@ def _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, f
         rise if first else start,
         seed,
         sigma,
+        numbers,
         # where the roughness stood at the previous step: a deterministic step's start generator
         _roughness_offset(mixed, surfaces, x, d_prev) if mixed == "deterministic" else None,
     )
@@ -381,6 +383,7 @@ def _run_in(surfaces: Surfaces, sol: EHLSolution, d) -> Surfaces:
 
 @eqx.filter_jit
 def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, solids):
+    numbers, model = _split_numbers(model)
     n = model.n_nodes
     depth = jnp.asarray(thermal_mod.depth_grid())
     first_contact = jax.tree_util.tree_map(lambda a: a[0], contacts)
@@ -395,7 +398,9 @@ def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, 
             model,
             False,
             mixed,
-            _Inputs(first_contact, lubricant, x0, jnp.zeros(()), x0, x0, x0, jnp.zeros(())),
+            _Inputs(
+                first_contact, lubricant, x0, jnp.zeros(()), x0, x0, x0, jnp.zeros(()), numbers
+            ),
             x0[:2],
             x0[:2],
             jnp.zeros(()),
@@ -429,13 +434,25 @@ def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, 
         surfaces if _runs_in(model, mixed) else None,
     )
     carry, sol0 = _step(
-        model, mixed, lubricant, surfaces, solids, depth, carry, first_contact, times[0], True
+        model,
+        numbers,
+        mixed,
+        lubricant,
+        surfaces,
+        solids,
+        depth,
+        carry,
+        first_contact,
+        times[0],
+        True,
     )
     rest = jax.tree_util.tree_map(lambda a: a[1:], contacts)
 
     def body(carry, xs):
         contact, t = xs
-        return _step(model, mixed, lubricant, surfaces, solids, depth, carry, contact, t, False)
+        return _step(
+            model, numbers, mixed, lubricant, surfaces, solids, depth, carry, contact, t, False
+        )
 
     carry, sols = jax.lax.scan(body, carry, (rest, times[1:]))
     sols = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[None], b]), sol0, sols)
