@@ -378,7 +378,7 @@ class TipReliefObjective(eqx.Module):
     surfaces: object
     op: OperatingPoint
     speeds_rpm: Float[Array, " N"]
-    fidelity: Fidelity = eqx.field(static=True)
+    fidelity: Fidelity
     both_gears: bool = eqx.field(static=True)
 
     def __call__(self, x):
@@ -396,7 +396,7 @@ class TorqueObjective(eqx.Module):
     surfaces: object
     op: OperatingPoint
     speeds_rpm: Float[Array, " N"]
-    fidelity: Fidelity = eqx.field(static=True)
+    fidelity: Fidelity
 
     def __call__(self, x):
         op = eqx.tree_at(lambda o: o.torque, self.op, jnp.asarray(x)[0])
@@ -413,7 +413,7 @@ class RoughnessScaleObjective(eqx.Module):
     surfaces: object
     op: OperatingPoint
     speeds_rpm: Float[Array, " N"]
-    fidelity: Fidelity = eqx.field(static=True)
+    fidelity: Fidelity
 
     def __call__(self, x):
         surfaces = eqx.tree_at(lambda s: s.scale, self.surfaces, jnp.asarray(x)[0])

@@ -351,7 +351,7 @@ def test_a_periodic_orbit_that_strikes_the_back_flanks_counts_their_loss():
     us, um = u2 - u1, 0.5 * (u1 + u2)
     sliding = us**2 / np.sqrt(us**2 + (SIGN_SLIDE_TO_ROLL * um) ** 2)
     w = np.asarray(back.load_share) * np.maximum(-force, 0.0)[:, None]
-    expected = np.mean(np.sum(fid.constant_mu * w * sliding, axis=1))
+    expected = float(np.mean(np.sum(float(fid.constant_mu) * w * sliding, axis=1)))
     assert expected > 0.02 * float(res.power_loss)  # measured 61.3 of 1489.0 W
     assert float(res.power_loss_back) == pytest.approx(expected, rel=1e-9)
     drive = float(np.mean(np.sum(np.asarray(res.power_loss_pair), axis=1)))

@@ -153,7 +153,7 @@ def _summary(cfg, main, reference, t_main, t_all):
             "wall_time_s": round(t_all, 2),
         },
         "inputs": cfg.echo,
-        "fidelity": {f: getattr(fid, f) for f in fid.__dataclass_fields__},
+        "fidelity": fid.flat(),
         "timing_s": {"sweep": round(t_main, 2), "total": round(t_all, 2)},
         "not_converged": [
             {"point": i, "speed_rpm": float(speeds[i]), "status": name}

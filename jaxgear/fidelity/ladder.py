@@ -59,12 +59,16 @@ _LAMBDA_OFF = 0.1
 
 def _number(name):
     def convert(value):
-        if isinstance(value, bool) or isinstance(value, str):
-            raise ValueError(f"Fidelity.{name} = {value!r} is not valid; valid: a real number")
+        low, high = CONSTANTS[name][1]
+        invalid = ValueError(
+            f"Fidelity.{name} = {value!r} is out of range; valid range: [{low:g}, {high:g}]"
+        )
+        if isinstance(value, bool | str):
+            raise invalid
         try:
             return jnp.asarray(value, dtype=jnp.result_type(float))
         except (TypeError, ValueError):
-            raise ValueError(f"Fidelity.{name} = {value!r} is not valid; valid: a real number") from None
+            raise invalid from None
 
     return eqx.field(converter=convert)
 
