@@ -8,7 +8,7 @@ load and surface velocities). The synthetic profiles (exponential autocorrelatio
 scale, so their film moves with the grid (``roughness_resolution``); a measured profile is
 band-limited by the stylus's short-wave cutoff λs (ISO 3274: 2.5 µm for λc = 0.8 mm), which
 ``short_cutoff`` applies. This benchmark solves the R10 contact, quasi-static loads at the speed
-given (the figures' own reproduction path, ``jaxgear.figures.field_contact``), with both profiles,
+given (the figures' own reproduction path, ``jaxgear.paper.field_contact``), with both profiles,
 unfiltered and at λs = 2.5 µm, on 513-4097 nodes.
 
 Run: ``python benchmarks/fig12_resolution.py [--nodes 513 1025 2049 4097] [--rpm 3500]
@@ -31,7 +31,7 @@ from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
 from roughness_resolution import add_cutoffs, timed_solve  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear import figures  # noqa: E402
+from jaxgear.paper import reference, reproduce  # noqa: E402
 
 FACE_WIDTH = 0.02  # m, the paper's pair
 ROLL_ANGLE = 17.0  # degrees of gear 1 (Fig. 12)
@@ -40,19 +40,19 @@ ROLL_ANGLE = 17.0  # degrees of gear 1 (Fig. 12)
 def r10_contact(rpm: float):
     """The loaded contact nearest 17° of a quasi-static quick reproduction at ``rpm`` (the loads of
     the calibrated pair's mesh cycle at 700 N m, 24 positions), and its roll angle."""
-    repro = figures.reproduce_paper(
+    repro = reproduce.reproduce_paper(
         jg.Fidelity(dynamics="quasi_static"),
         quick=True,
         speeds_rpm=[rpm],
         variant_speeds_rpm=[rpm],
     )
     result = repro.quasi_static
-    i, slot, roll = figures._slot_at(repro, ROLL_ANGLE, result.tooth_force[0])
-    return figures.field_contact(repro, result, 0, i, slot), roll, repro.lubricant
+    i, slot, roll = reproduce._slot_at(repro, ROLL_ANGLE, result.tooth_force[0])
+    return reproduce.field_contact(repro, result, 0, i, slot), roll, repro.lubricant
 
 
 def _row(contact, lub, kind, cutoff_um, n):
-    surf = figures.field_surfaces(kind, None if cutoff_um == 0.0 else cutoff_um * 1e-6)
+    surf = reproduce.field_surfaces(kind, None if cutoff_um == 0.0 else cutoff_um * 1e-6)
     sol, wall = timed_solve(contact, lub, surf, n)
     dx = float(sol.x[1] - sol.x[0])
     label = "unfiltered" if cutoff_um == 0.0 else f"λs = {cutoff_um:g} µm"
@@ -69,7 +69,7 @@ def _row(contact, lub, kind, cutoff_um, n):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--nodes", type=int, nargs="+", default=[513, 1025, 2049, 4097])
-    add_cutoffs(ap, [0.0, figures.FIELD_SHORT_CUTOFF * 1e6])
+    add_cutoffs(ap, [0.0, reference.FIELD_SHORT_CUTOFF * 1e6])
     ap.add_argument("--kinds", nargs="+", default=["polished", "ground"])
     ap.add_argument("--rpm", type=float, default=3500.0)
     ap.add_argument("--rows", type=Path, help=ROWS_HELP)

@@ -39,7 +39,7 @@ jax.config.update("jax_enable_x64", True)
 from _report import effective_friction, machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear.figures import (  # noqa: E402
+from jaxgear.paper.reference import (  # noqa: E402
     NOMINAL_POINTS_RPM,
     PAPER_QUASI_STATIC_W,
     PAPER_TRIBO_DYNAMIC_W,

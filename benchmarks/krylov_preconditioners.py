@@ -38,9 +38,9 @@ from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear.figures import field_surfaces  # noqa: E402
 from jaxgear.lubrication import ehl  # noqa: E402
 from jaxgear.lubrication.passage import grid_time_step  # noqa: E402
+from jaxgear.paper import field_surfaces  # noqa: E402
 
 LUB = jg.presets.mil_l_23699()
 RTOL = 1e-3  # the solver's direction tolerance (ehl._DIRECTION_TOLERANCE)

@@ -635,7 +635,7 @@ def engagement_fine(
 
     import numpy as np
 
-    from jaxgear.figures import field_surfaces
+    from jaxgear.paper import field_surfaces
 
     surf = field_surfaces("polished")
 
@@ -727,7 +727,7 @@ def _held_row(n, k, thermal, label, polished=False, **model_options):
 
     import numpy as np
 
-    from jaxgear.figures import field_surfaces  # λs = 2.5 µm, the figures' stylus cutoff
+    from jaxgear.paper import field_surfaces  # λs = 2.5 µm, the figures' stylus cutoff
 
     model = jg.EHLModel(n_nodes=n, mixed="deterministic", thermal=thermal, **model_options)
     c = gear_contact(rpm=3500.0)

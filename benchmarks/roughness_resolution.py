@@ -34,8 +34,8 @@ from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear.figures import FIELD_SHORT_CUTOFF  # noqa: E402
 from jaxgear.lubrication import roughness as rough  # noqa: E402
+from jaxgear.paper.reference import FIELD_SHORT_CUTOFF  # noqa: E402
 
 LUB = jg.presets.mil_l_23699()
 CUTOFF = FIELD_SHORT_CUTOFF  # m, ISO 3274 λs for Ra 0.1-2 µm profiles (λc = 0.8 mm)

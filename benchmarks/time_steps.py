@@ -42,8 +42,8 @@ from _report import (  # noqa: E402
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear.figures import field_surfaces  # noqa: E402
 from jaxgear.lubrication.passage import grid_time_step, solve_ehl_passage  # noqa: E402
+from jaxgear.paper import field_surfaces  # noqa: E402
 
 LUB = jg.presets.mil_l_23699()
 WINDOW_CELLS_2049 = 40  # the rolling distance, in cells of the 2049-node grid

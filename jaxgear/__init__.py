@@ -6,7 +6,8 @@ ladder). SI units inside. Enable float64 (``jax.config.update("jax_enable_x64", 
 the library never changes ``jax.config`` itself.
 """
 
-from . import figures as figures
+from . import paper as figures  # the former name of jaxgear.paper
+from . import paper as paper
 from . import presets as presets
 from . import units as units
 from .gear.geometry import GearGeometry as GearGeometry

@@ -285,7 +285,7 @@ def test_figures_quick_fast_fidelity(tmp_path, capsys):
 def test_contact_fields_on_an_ehl_rung():
     # Figs. 7/12 and R11 from contact fields: the loads and velocities of a cheap quasi-static
     # regression run, the contacts solved by smooth iso-thermal EHL (the fidelity's EHL model).
-    from jaxgear.figures import _contact_fields
+    from jaxgear.paper.reproduce import _contact_fields
 
     repro = jg.figures.reproduce_paper(
         Fidelity(dynamics="quasi_static"), quick=True, speeds_rpm=[1800.0, 3500.0]
@@ -310,8 +310,8 @@ def test_fig12_solves_the_roughness_deterministically_on_the_mixed_rung():
     # R10: at the mixed rung, Fig. 12 solves the 17° contact at speed E with the roughness profiles
     # as a stylus measures them (λs = 2.5 µm; 2049 nodes, iso-thermal snapshot); loads and
     # velocities from a cheap quasi-static run.
-    from jaxgear.figures import (
-        FIELD_DETERMINISTIC_NODES,
+    from jaxgear.paper.reference import FIELD_DETERMINISTIC_NODES
+    from jaxgear.paper.reproduce import (
         _contact_fields,
         _indices_of,
         _slot_at,
@@ -356,7 +356,7 @@ def test_fig12_solves_the_roughness_deterministically_on_the_mixed_rung():
 def test_speed_e_joins_the_variant_speeds_only_between_them():
     # Fig. 12 / R10 need the polished variant at speed E. On the paper's 25 rpm grid E sits at the
     # DTE peak (3375 rpm), between the variants' 100 or 200 rpm steps: it is added there, in order.
-    from jaxgear.figures import _with_speed_e
+    from jaxgear.paper.reproduce import _with_speed_e
 
     v = np.arange(500.0, 4201.0, 200.0)
     added = _with_speed_e(v, 3375.0)
@@ -375,7 +375,7 @@ def test_points_a_to_e_sit_at_the_resonances_not_in_a_back_flank_rattle():
     # pull E out of the resonance; without its back-contact flag it would.
     from types import SimpleNamespace
 
-    from jaxgear.figures import _place_points
+    from jaxgear.paper.reproduce import _place_points
 
     speeds = np.arange(500.0, 4200.0 + 1e-9, 25.0)
     dte = 5e-6 + 22e-6 * np.exp(-(((speeds - 1750.0) / 60.0) ** 2))

@@ -13,7 +13,7 @@ import pytest
 import jaxgear as jg
 from jaxgear.cli import build_parser
 from jaxgear.config import fidelity_from_config
-from jaxgear.figures import _contact_parameters
+from jaxgear.paper.figures import _contact_parameters
 
 
 def test_preset_is_the_paper_fidelity_with_the_calibrated_contact():

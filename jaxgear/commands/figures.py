@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from jaxgear.fidelity import Fidelity
-    from jaxgear.figures import reproduce_paper, table_markdown, write_report
+    from jaxgear.paper import reproduce_paper, table_markdown, write_report
 
     speeds = variant_speeds = None
     if not args.quick:

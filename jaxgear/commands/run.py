@@ -215,7 +215,7 @@ def _peak(speeds, values, lo, hi):
 
 
 def _summary(speeds, td, qs, fid, args, t_td, t_all):
-    from jaxgear.figures import _resonance_dte
+    from jaxgear.paper.reproduce import _resonance_dte
 
     ok = ~td.failed
     resonance = _resonance_dte(td)
