@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 from _report import bands, machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear.commands.run import _peak as run_peak  # noqa: E402
+from jaxgear.cli.commands.run import _peak as run_peak  # noqa: E402
 from jaxgear.paper.reproduce import _resonance_dte  # noqa: E402
 
 POINTS = {"A": 1700.0, "B": 1800.0, "C": 2550.0, "D": 3300.0, "E": 3500.0}

@@ -16,7 +16,7 @@ import pytest
 
 import jaxgear as jg
 from jaxgear.cli import main
-from jaxgear.commands import ehl as ehl_command
+from jaxgear.cli.commands import ehl as ehl_command
 from jaxgear.lubrication.lubricant import Lubricant
 
 NAN = float("nan")

@@ -81,7 +81,7 @@ def test_summary_reports_the_resonance_peaks_apart_from_a_back_flank_rattle():
 
     import numpy as np
 
-    from jaxgear.commands.run import _summary
+    from jaxgear.cli.commands.run import _summary
     from jaxgear.fidelity import Fidelity
 
     speeds = np.arange(500.0, 4200.0 + 1e-9, 25.0)

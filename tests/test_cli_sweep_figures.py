@@ -18,7 +18,7 @@ import pytest
 
 import jaxgear as jg
 from jaxgear.cli import main
-from jaxgear.config import load_toml, sweep_from_config
+from jaxgear.cli.config import load_toml, sweep_from_config
 from jaxgear.fidelity import Fidelity
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -6,7 +6,7 @@ import json
 import pytest
 from ehl_cases import gear_contact
 
-from jaxgear.commands import ehl as ehl_command
+from jaxgear.cli.commands import ehl as ehl_command
 
 # the suite's standard model (129 nodes, default physics): compiled once for all EHL tests
 ARGS = ["--nodes", "129"]

@@ -577,7 +577,7 @@ def test_cli_run_help_lists_auto(capsys):
 
 
 def test_cli_auto_prints_its_reasons(capsys):
-    from jaxgear.commands.run import _fidelity
+    from jaxgear.cli.commands.run import _fidelity
 
     args = argparse.Namespace(fidelity="auto", tolerance=0.05)
     speeds = np.array([1500.0, 2000.0])

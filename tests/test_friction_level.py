@@ -16,7 +16,7 @@ import pytest
 from ehl_cases import gear_contact, greenwood_tripp_pressure
 
 import jaxgear as jg
-from jaxgear.config import fidelity_from_config, sweep_from_config
+from jaxgear.cli.config import fidelity_from_config, sweep_from_config
 from jaxgear.contact.ehl import ehl_model_of
 
 LUB = jg.presets.mil_l_23699()

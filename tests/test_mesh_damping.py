@@ -143,7 +143,7 @@ def test_bad_damping_ratio_names_the_field(bad):
 
 
 def test_damping_ratio_from_config():
-    from jaxgear.config import gear_pair_from_config
+    from jaxgear.cli.config import gear_pair_from_config
 
     pair = gear_pair_from_config({"gear": {"mesh_damping_ratio": 0.05}})
     assert float(pair.mesh_damping_ratio) == 0.05

@@ -12,7 +12,7 @@ import pytest
 
 import jaxgear as jg
 from jaxgear.cli import build_parser
-from jaxgear.config import fidelity_from_config
+from jaxgear.cli.config import fidelity_from_config
 from jaxgear.paper.figures import _contact_parameters
 
 

@@ -329,7 +329,7 @@ def test_short_cutoff_passes_through_the_presets():
 
 def test_short_cutoff_from_a_sweep_config():
     # the TOML key is in µm (units at the edges); the echo carries it into the sweep's summary
-    from jaxgear.config import surfaces_from_config
+    from jaxgear.cli.config import surfaces_from_config
 
     surf, echo = surfaces_from_config({"surfaces": {"preset": "ground", "short_cutoff_um": 2.5}})
     ref = jg.presets.ground(short_cutoff=2.5e-6)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import jaxgear as jg
-from jaxgear.config import fidelity_from_config
+from jaxgear.cli.config import fidelity_from_config
 from jaxgear.contact.ehl import ehl_model_of
 
 PAIR = jg.presets.li2015_pair_calibrated()

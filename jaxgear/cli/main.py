@@ -1,6 +1,6 @@
 """The ``jaxgear`` command line.
 
-Each subcommand lives in ``jaxgear/commands/<name>.py`` and exposes ``register(subparsers)``, which adds
+Each subcommand lives in ``jaxgear/cli/commands/<name>.py`` and exposes ``register(subparsers)``, which adds
 its parser and sets ``func`` (a callable taking the parsed namespace and returning an exit code).
 Invalid input (``ValueError``) ends with a one-line message on stderr and exit code 2, never a traceback.
 """
@@ -33,7 +33,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
-        importlib.import_module(f"jaxgear.commands.{name}").register(sub)
+        importlib.import_module(f"jaxgear.cli.commands.{name}").register(sub)
     return parser
 
 
@@ -82,7 +82,3 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into `head` and the like
         sys.stderr.close()
         return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -52,8 +52,8 @@ from typing import Any
 
 import numpy as np
 
-from .fidelity import NAMED_PRESETS
-from .gear.pair import Bearings, GearPair, TipRelief
+from ..fidelity import NAMED_PRESETS
+from ..gear.pair import Bearings, GearPair, TipRelief
 
 _GEAR_KEYS = {
     "preset": str,
@@ -134,7 +134,7 @@ GEAR_PRESETS = ("li2015", "li2015_calibrated", "none")
 
 def gear_pair_from_config(cfg: dict[str, Any], default_preset: str = "li2015") -> GearPair:
     """Build a GearPair from the ``[gear]`` table of a config dict (see the module docstring)."""
-    from . import presets
+    from .. import presets
 
     gear = dict(cfg.get("gear", {}))
     check_keys(gear, _GEAR_KEYS, "gear")
@@ -308,7 +308,7 @@ class SweepConfig:
 
 
 def _lubricant_keys() -> dict:
-    from .lubrication.lubricant import Lubricant
+    from ..lubrication.lubricant import Lubricant
 
     keys: dict[str, Any] = {"preset": str}
     for f in dataclasses.fields(Lubricant):
@@ -320,7 +320,7 @@ def lubricant_from_config(cfg: dict[str, Any]):
     """``[lubricant]``: ``preset`` ("mil_l_23699" or "iso_vg68") and any ``jg.Lubricant`` field to
     override, in that class's SI units (e.g. ``kinematic_viscosity_40 = 2.5e-5`` m²/s,
     ``eyring_stress = 5e6`` Pa)."""
-    from . import presets
+    from .. import presets
 
     table = dict(cfg.get("lubricant", {}))
     check_keys(table, _lubricant_keys(), "lubricant")
@@ -343,9 +343,9 @@ def surfaces_from_config(cfg: dict[str, Any]):
     """``[surfaces]``: ``preset`` ("ground", "polished", "smooth"), ``scale`` (≥ 0), ``seed`` of the
     synthetic profiles, and optionally ``rq_um`` / ``correlation_length_um`` / ``short_cutoff_um``
     (the stylus cutoff λs) for other synthetic Gaussian profiles (REFERENCE §6)."""
-    from . import presets
-    from ._validation import check_non_negative, check_positive
-    from .lubrication import roughness
+    from .. import presets
+    from .._validation import check_non_negative, check_positive
+    from ..lubrication import roughness
 
     table = dict(cfg.get("surfaces", {}))
     check_keys(table, _SURFACE_KEYS, "surfaces")
@@ -385,7 +385,7 @@ def surfaces_from_config(cfg: dict[str, Any]):
 
 
 def _fidelity_keys() -> dict:
-    from .fidelity.ladder import FLAT_DEFAULTS
+    from ..fidelity.ladder import FLAT_DEFAULTS
 
     keys: dict[str, Any] = {"preset": str, "tolerance": float}
     for name, default in FLAT_DEFAULTS.items():
@@ -405,8 +405,8 @@ def fidelity_from_config(cfg: dict[str, Any], preset: str | None = None):
     ladder fields (physics axes and resolution) must be left out, since ``Fidelity.auto`` sets
     them; ``tolerance`` (default 0.05) is the choice's tolerance and the caller makes the choice
     (it needs the scenario: see ``sweep_from_config``)."""
-    from .fidelity import Fidelity
-    from .fidelity.choose import LADDER_FIELDS
+    from ..fidelity import Fidelity
+    from ..fidelity.choose import LADDER_FIELDS
 
     table = dict(cfg.get("fidelity", {}))
     check_keys(table, _fidelity_keys(), "fidelity")
@@ -445,7 +445,7 @@ def fidelity_from_config(cfg: dict[str, Any], preset: str | None = None):
 
 
 def _speeds(table) -> np.ndarray:
-    from ._validation import check_positive
+    from .._validation import check_positive
 
     if ("speeds_rpm" in table) == ("speed_range_rpm" in table):
         raise ValueError(
@@ -480,7 +480,7 @@ def _speeds(table) -> np.ndarray:
 
 
 def _vary(table, n) -> tuple[dict, dict]:
-    from ._validation import check_non_negative, check_positive, check_range
+    from .._validation import check_non_negative, check_positive, check_range
 
     vary = dict(table.get("vary", {}))
     check_keys(vary, {k: (float, list) for k in _VARY_KEYS}, "sweep.vary")
@@ -524,8 +524,8 @@ def sweep_from_config(cfg: dict[str, Any], fidelity: str | None = None) -> Sweep
 
     Raises ValueError naming the key, the value and the valid range.
     """
-    from ._validation import check_positive, check_range
-    from .operating import OperatingPoint
+    from .._validation import check_positive, check_range
+    from ..operating import OperatingPoint
 
     check_top_level(cfg, SWEEP_TABLES)
     pair = gear_pair_from_config(cfg, default_preset="li2015_calibrated")
@@ -602,7 +602,7 @@ def _auto_fidelity(pair, lub, surf, op, speeds, vary, base, tolerance):
     """``[fidelity] preset = "auto"``: ``jg.choose_fidelity`` over the sweep's speeds, keeping the
     base's other fields. The indicators are those of ``[operating]``, so inputs that move them may
     not vary per speed."""
-    from .fidelity.choose import choose_fidelity
+    from ..fidelity.choose import choose_fidelity
 
     moving = sorted(k for k in vary if k != "tip_relief_amount")
     if moving:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from jaxgear.config import FIDELITY_PRESETS
+from jaxgear.cli.config import FIDELITY_PRESETS
 
 #: Most speeds one run takes (the paper's sweep has 149).
 MAX_SPEEDS = 100_000

@@ -103,7 +103,7 @@ def _summary(pair, geo, mesh) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     import jaxgear as jg
-    from jaxgear.config import (
+    from jaxgear.cli.config import (
         check_top_level,
         gear_pair_from_config,
         load_toml,

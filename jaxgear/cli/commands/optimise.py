@@ -94,7 +94,7 @@ def _pair_of_numbers(name, value):
 
 def run(args: argparse.Namespace) -> int:
     import jaxgear as jg
-    from jaxgear.config import (
+    from jaxgear.cli.config import (
         check_keys,
         check_top_level,
         gear_pair_from_config,

@@ -109,7 +109,7 @@ def _load_config(path: str | None) -> dict:
     ValueError naming it, so the command exits 2 with one line instead of a traceback)."""
     if path is None:
         return {}
-    from jaxgear.config import check_keys, check_top_level, load_toml
+    from jaxgear.cli.config import check_keys, check_top_level, load_toml
 
     cfg = load_toml(path)
     check_top_level(cfg, ("lubricant", "contact", "model"))

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from jaxgear.config import FIDELITY_PRESETS
+from jaxgear.cli.config import FIDELITY_PRESETS
 
 
 def register(sub) -> None:
@@ -41,7 +41,7 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from jaxgear.config import load_toml, sweep_from_config
+    from jaxgear.cli.config import load_toml, sweep_from_config
     from jaxgear.sweep import sweep
 
     cfg = sweep_from_config(load_toml(args.config), fidelity=args.fidelity)

@@ -1,1 +1,0 @@
-"""Subcommands of the ``jaxgear`` command line (one module each, see ``jaxgear.cli``)."""
