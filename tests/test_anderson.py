@@ -1,4 +1,4 @@
-"""Anderson acceleration (jaxgear.anderson) against closed-form fixed points.
+"""Anderson acceleration (jaxgear._solvers.anderson) against closed-form fixed points.
 
 Checked against things it does not produce: the fixed point of an affine contraction solved by a
 linear solve, the iteration count of plain iteration on the same map, implicit gradients against the
@@ -11,7 +11,7 @@ import numpy as np
 import optimistix as optx
 import pytest
 
-from jaxgear.anderson import Anderson
+from jaxgear._solvers.anderson import Anderson
 
 jax.config.update("jax_enable_x64", True)
 

@@ -13,8 +13,8 @@ import pytest
 
 import jaxgear as jg
 import jaxgear.tribodynamics.passes as passes
-from jaxgear._implicit import NaNImplicitAdjoint
-from jaxgear._krylov import EarlyExitGMRES
+from jaxgear._solvers.implicit import NaNImplicitAdjoint
+from jaxgear._solvers.krylov import EarlyExitGMRES
 
 PAIR = jg.presets.li2015_pair_calibrated()
 LUB, SURF = jg.presets.mil_l_23699(), jg.presets.ground()

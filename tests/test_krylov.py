@@ -1,4 +1,4 @@
-"""EarlyExitGMRES (jaxgear/_krylov.py): the linear solver of the fixed point's implicit derivative.
+"""EarlyExitGMRES (jaxgear/_solvers/krylov.py): the linear solver of the fixed point's implicit derivative.
 
 Checked against dense solves (numpy), the finite-termination property of GMRES, and lineax's own
 GMRES on the matrix-vector count it exists to cut."""
@@ -9,7 +9,7 @@ import lineax as lx
 import numpy as np
 import pytest
 
-from jaxgear._krylov import EarlyExitGMRES
+from jaxgear._solvers.krylov import EarlyExitGMRES
 
 SIZES = (64, 13, 32)
 SCALES = (1e4, 1.0, 1e-6)  # N, a scaled orbit state, m: the fixed point's leaves differ this much

@@ -8,7 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxgear._lazy_cond import cond_any_member
+from jaxgear._solvers.lazy_cond import cond_any_member
 
 
 def _counting():

@@ -13,8 +13,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxgear import sweep_engine
-from jaxgear.sweep_engine import (
+from jaxgear.sweep import engine as sweep_engine
+from jaxgear.sweep.engine import (
     FAILED,
     NON_FINITE,
     NOT_CONVERGED,
@@ -264,7 +264,7 @@ def test_sharded_over_two_host_devices_equals_single_device(tmp_path):
         """
         import jax, numpy as np, jax.numpy as jnp
         jax.config.update("jax_enable_x64", True)
-        from jaxgear.sweep_engine import run_points
+        from jaxgear.sweep.engine import run_points
         assert len(jax.devices()) == 2, jax.devices()
         f = lambda p: {"y": jnp.sin(p["x"]) * jnp.exp(-p["x"])}
         xs = np.linspace(0.0, 5.0, 13)

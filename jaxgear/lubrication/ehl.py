@@ -37,7 +37,7 @@ import jax.scipy.linalg
 import numpy as np
 from jaxtyping import Array, Bool, Float, Int
 
-from .._lazy_cond import cond_any_member
+from .._solvers.lazy_cond import cond_any_member
 from .._validation import (
     check_choice,
     check_finite,
@@ -1196,7 +1196,7 @@ def _krylov_direction(level: _Level, u, s, f):
     """
     import lineax as lx
 
-    from .._krylov import EarlyExitGMRES
+    from .._solvers.krylov import EarlyExitGMRES
 
     factors = _block_preconditioner(level, u, s)
     _, jvp = jax.linearize(lambda v: level.residual(v, s), u)

@@ -5,7 +5,7 @@ forces F1, F2 per position and tooth pair), give the dynamic tooth forces W_T an
 velocities uj; the contacts, given W_T and uj, give new tables; the two are iterated to a fixed
 point. The fixed point is solved with optimistix (Anderson-accelerated, or damped iteration) and
 differentiated implicitly (``optx.ImplicitAdjoint`` with a matrix-free GMRES solve of (I − ∂T/∂x)
-that stops at the Krylov step where it has converged, ``_krylov.EarlyExitGMRES``), so gradients
+that stops at the Krylov step where it has converged, ``_solvers.krylov.EarlyExitGMRES``), so gradients
 never pass through the iterations, in forward or reverse mode. The dynamic periodic orbit is
 carried in the fixed-point state, so each iteration's shooting starts from the previous orbit.
 
@@ -21,9 +21,9 @@ import jax.numpy as jnp
 import optimistix as optx
 from jaxtyping import Array, Float, Int
 
-from .._implicit import NaNImplicitAdjoint
-from .._krylov import EarlyExitGMRES
-from ..anderson import Anderson
+from .._solvers.anderson import Anderson
+from .._solvers.implicit import NaNImplicitAdjoint
+from .._solvers.krylov import EarlyExitGMRES
 from ..contact.base import ContactForces, interface_from_forces, kinematic_velocities
 from ..contact.cycle import contact_forces
 from ..contact.frozen import frozen_contact_forces

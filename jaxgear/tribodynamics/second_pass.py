@@ -15,7 +15,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from .._lazy_cond import cond_any_member
+from .._solvers.lazy_cond import cond_any_member
 from ..contact.base import kinematic_velocities, safe_sqrt
 from ..dynamics.attractor import DEFAULT_KICK, record_attractor
 from ..dynamics.model import build_dynamics

@@ -16,14 +16,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._inputs import canonical, validate
-from ._validation import check_non_negative, check_positive, check_range
-from .fidelity import Fidelity
-from .gear.pair import MAX_RELIEF_PER_MODULE
-from .operating import OperatingPoint
-from .sweep_engine import STATUS_NAMES as POINT_STATUS_NAMES
-from .sweep_engine import run_continuation, run_points
-from .tribodynamics import (
+from .._inputs import canonical, validate
+from .._validation import check_non_negative, check_positive, check_range
+from ..fidelity import Fidelity
+from ..gear.pair import MAX_RELIEF_PER_MODULE
+from ..operating import OperatingPoint
+from ..tribodynamics import (
     STATUS_ATTRACTOR,
     STATUS_NAMES,
     STATUS_PENDING,
@@ -33,6 +31,8 @@ from .tribodynamics import (
     first_pass,
     needs_second_pass,
 )
+from .engine import STATUS_NAMES as POINT_STATUS_NAMES
+from .engine import run_continuation, run_points
 
 #: Inputs a sweep may vary, besides the speed.
 SWEEPABLE = (
@@ -237,8 +237,10 @@ def _second_pass(out, raw_status, inputs, shared, continuation: bool):
     for i in idx:
         point = {k: jnp.asarray(v[i]) for k, v in inputs.items()}
         pending = jax.tree_util.tree_map(lambda a, i=i: jnp.asarray(a[i]), pending_all)
-        warm = handover if (continuation and previous == i - 1) else (
-            jnp.zeros(13, dtype), jnp.zeros((), dtype)
+        warm = (
+            handover
+            if (continuation and previous == i - 1)
+            else (jnp.zeros(13, dtype), jnp.zeros((), dtype))
         )
         new, handover = _finish_point(point, pending, warm, shared)
         previous = i
