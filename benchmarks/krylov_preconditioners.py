@@ -38,12 +38,13 @@ from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
 from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
-from jaxgear.lubrication import ehl  # noqa: E402
+from jaxgear.lubrication.ehl.discretisation import _fine_level, _grid_positions  # noqa: E402
+from jaxgear.lubrication.ehl.model import _Inputs  # noqa: E402
 from jaxgear.lubrication.passage import grid_time_step  # noqa: E402
 from jaxgear.paper import field_surfaces  # noqa: E402
 
 LUB = jg.presets.mil_l_23699()
-RTOL = 1e-3  # the solver's direction tolerance (ehl._DIRECTION_TOLERANCE)
+RTOL = 1e-3  # the solver's direction tolerance (ehl.newton._DIRECTION_TOLERANCE)
 BANDS = (1, 4, 16, 64)
 BLOCKS = (32, 64, 128, 256)
 
@@ -56,7 +57,7 @@ def _system(n, kind):
     dt = float(grid_time_step(contact, LUB, model))
     moved = jnp.asarray([float(contact.u1) * dt, float(contact.u2) * dt])
     first = jg.solve_ehl(contact, LUB, model, surf)
-    x = ehl._grid_positions(model, contact, LUB)
+    x = _grid_positions(model, contact, LUB)
 
     def level(displacement, previous):
         zero = jnp.zeros((n,))
@@ -69,8 +70,8 @@ def _system(n, kind):
             surf.displaced_height(0, x, displacement[0])
             + surf.displaced_height(1, x, displacement[1])
         )
-        inp = ehl._Inputs(contact, LUB, rho_h, inv_dt, offset, zero, zero, surf.composite_rq)
-        return ehl._fine_level(model, dataclasses.replace(inp, rough=True))[1]
+        inp = _Inputs(contact, LUB, rho_h, inv_dt, offset, zero, zero, surf.composite_rq)
+        return _fine_level(model, dataclasses.replace(inp, rough=True))[1]
 
     steady, step = level(jnp.zeros(2), None), level(moved, first)
     film_unit = float(steady.sc.b**2 / contact.reduced_radius)

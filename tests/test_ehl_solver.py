@@ -320,9 +320,9 @@ def test_default_solids_first_built_inside_a_trace_do_not_leak():
     filled inside a jit trace it held that trace's tracers, and the next call of the same
     compiled function failed ("Execution supplied 21 arguments but compiled program expected
     24")."""
-    from jaxgear.lubrication import ehl
+    from jaxgear.lubrication.ehl.solve import _default_solids
 
-    ehl._default_solids.cache_clear()
+    _default_solids.cache_clear()
     model = jg.EHLModel(n_nodes=65)
     f = eqx.filter_jit(lambda c: jg.solve_ehl(c, LUB, model).h_central)
     c = gear_contact()

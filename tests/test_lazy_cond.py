@@ -1,4 +1,4 @@
-"""The vmap-lazy cond (``jaxgear._lazy_cond.cond_any_member``, used by the EHL solver and the
+"""The vmap-lazy cond (``jaxgear._solvers.lazy_cond.cond_any_member``, used by the EHL solver and the
 coupled model's attractor branch): the same values as ``lax.cond``, and under vmap a branch that no member takes does not run. Plain ``vmap(lax.cond)`` runs both branches for
 every member, which made a vmapped batch of 64 contacts pay for every fallback attempt (211 ms per
 contact against 21 ms solved one by one; benchmarks/ehl_kernel.py)."""

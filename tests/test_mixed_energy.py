@@ -308,7 +308,7 @@ def _outlet_bump_jvp():
 
 def test_gradient_is_finite_and_continuous_where_asperity_contact_switches_on():
     """The bump closes the film as its scale grows: contact (the smooth indicator,
-    ``ehl._contact_indicator``: 1 below the threshold film, 0 above twice it) appears between
+    ``ehl.core._contact_indicator``: 1 below the threshold film, 0 above twice it) appears between
     scales 0.69 and 0.73. Measured (2026-11-30, jvp; central differences agree):
 
     - no contact (scale ≤ 0.66, h_min ≥ 5 × threshold): dP/ds = −62 … −8 W/m per unit scale;

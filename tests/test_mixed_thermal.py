@@ -124,8 +124,9 @@ def test_deterministic_transient_step_is_reached_from_the_previous_step_by_relax
 
 def test_relaxation_sweeps_default_to_100_iso_thermal_and_50_thermal_and_are_validated():
     # The default (None) is resolved by the solve: 100 sweeps iso-thermal, 50 thermal (measured
-    # cheaper for the thermal passage, ``ehl._relaxation_sweeps``); a given count is used as is.
-    from jaxgear.lubrication.ehl import _relaxation_sweeps
+    # cheaper for the thermal passage, ``ehl.starts._relaxation_sweeps``); a given count is used
+    # as is.
+    from jaxgear.lubrication.ehl.starts import _relaxation_sweeps
 
     assert _relaxation_sweeps(jg.EHLModel(mixed="deterministic")) == 100
     assert _relaxation_sweeps(jg.EHLModel(mixed="deterministic", thermal=True)) == 50
@@ -150,7 +151,11 @@ def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_st
     # wedge term, so the r = 0 reference carries the smooth film's wedge in the squeeze term.
     import dataclasses
 
-    from jaxgear.lubrication import ehl
+    from jaxgear.lubrication.ehl.continuation import _rough_homotopy
+    from jaxgear.lubrication.ehl.discretisation import _grid_positions, _levels
+    from jaxgear.lubrication.ehl.model import _Inputs
+    from jaxgear.lubrication.ehl.newton import _newton
+    from jaxgear.lubrication.ehl.starts import _cold_start, _schedules
 
     model = dataclasses.replace(DET, transport=transport)
     c = gear_contact(rpm=3500.0)
@@ -159,11 +164,11 @@ def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_st
     steady = jg.solve_ehl(c, LUB, model, surf, displacement=jnp.zeros(2))
     assert bool(steady.converged)
     # the next step's inputs, as solve_ehl builds them
-    x = ehl._grid_positions(model, c, LUB)
+    x = _grid_positions(model, c, LUB)
     d = np.asarray([float(c.u1), float(c.u2)]) * dt
     offset = -(surf.displaced_height(0, x, d[0]) + surf.displaced_height(1, x, d[1]))
     zero = jnp.zeros_like(x)
-    inp = ehl._Inputs(
+    inp = _Inputs(
         c,
         LUB,
         jnp.interp(x, steady.x, steady.rho_h),
@@ -173,13 +178,13 @@ def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_st
         zero,
         surf.composite_rq,
     )
-    _, levels = ehl._levels(model, inp)
+    _, levels = _levels(model, inp)
     fine = levels[-1]
     smooth = [lev.smooth_steady() for lev in levels]
-    start, _ = ehl._cold_start(model, smooth, ehl._schedules(model, x.dtype)[0], cubic=True)
-    u_s, res, _, ok = ehl._newton(smooth[-1], start, 1.0, model.max_iterations)
+    start, _ = _cold_start(model, smooth, _schedules(model, x.dtype)[0], cubic=True)
+    u_s, res, _, ok = _newton(smooth[-1], start, 1.0, model.max_iterations)
     assert bool(ok), float(res)
-    system = ehl._rough_homotopy(fine, smooth[-1].rho_h(u_s))
+    system = _rough_homotopy(fine, smooth[-1].rho_h(u_s))
     at_zero, s = system(0.0)
     assert s == 1.0
     # r = 0: solved by the smooth steady film (to its Newton tolerance, 1e-9)
@@ -349,7 +354,7 @@ def test_temperature_steps_is_validated():
 @pytest.mark.slow
 def test_thermal_deterministic_full_ground_settles_on_513_nodes_with_a_loss_close_to_257():
     # Speed E, 513 nodes (Δx ≈ 3 µm). Before the temperature step was limited
-    # (ehl._DETERMINISTIC_TEMPERATURE_STEP), the first update asked for a film 1292 K hot, the
+    # (ehl.outer._DETERMINISTIC_TEMPERATURE_STEP), the first update asked for a film 1292 K hot, the
     # Reynolds solves at the 400-900 K films that followed failed, and the solve ended not
     # converged (residual 0.84 after 16 updates). Limited to 200 K a step it settles (23 updates).
     # The loss per unit width is a grid-level quantity: 85.7 kW/m against 89.5 kW/m on 257 nodes
@@ -398,7 +403,7 @@ def test_aitken_relaxation_limited_step_bounds_each_update_and_reaches_the_fixed
     # max_step (the deterministic films' trust region): on g(x) = a x + c with a = −0.9 the first
     # unrelaxed update would move x by up to 2 (the largest c); limited to 0.25 no entry moves by
     # more than that in any update, and the relaxed iteration still converges to c/(1 − a)
-    from jaxgear.lubrication.ehl import _aitken
+    from jaxgear.lubrication.ehl.outer import _aitken
 
     a, c = -0.9, jnp.linspace(1.0, 2.0, 5)
     x = jnp.zeros(5)
@@ -414,10 +419,10 @@ def test_aitken_relaxation_limited_step_bounds_each_update_and_reaches_the_fixed
 
 
 def test_aitken_relaxation_settles_an_oscillating_update_and_leaves_a_monotone_one_alone():
-    # the temperature update's relaxation (ehl._aitken) on linear maps g(x) = a x + c, whose fixed
-    # point is c/(1 − a): for a = −1.5 the plain iteration diverges (|a| > 1); Aitken's secant ω is
-    # exact for a linear map from its second update on
-    from jaxgear.lubrication.ehl import _aitken
+    # the temperature update's relaxation (ehl.outer._aitken) on linear maps g(x) = a x + c, whose
+    # fixed point is c/(1 − a): for a = −1.5 the plain iteration diverges (|a| > 1); Aitken's
+    # secant ω is exact for a linear map from its second update on
+    from jaxgear.lubrication.ehl.outer import _aitken
 
     c = jnp.linspace(1.0, 2.0, 5)
     for a, updates in ((-1.5, 3), (-0.9, 3)):
@@ -610,12 +615,12 @@ def test_bounded_temperatures_of_a_failed_solve_keep_the_lubricant_finite(lub):
     # range, every lubricant property the film and its outputs use must be finite, and the density
     # positive. (At the former +1500 K bound a 1025-node passage step reported NaN viscosities: the
     # linear expansion's density changes sign near 1700 K.)
-    from jaxgear.lubrication import ehl
+    from jaxgear.lubrication.ehl.outer import _MAX_RISE, _MIN_RISE, _safe_rise
 
     wild = jnp.asarray([-1e4, -60.0, 0.0, 1200.0, 1e4, jnp.inf, -jnp.inf, jnp.nan])
-    rise = ehl._safe_rise(wild)
+    rise = _safe_rise(wild)
     assert bool(jnp.all(jnp.isfinite(rise)))
-    assert float(jnp.min(rise)) == ehl._MIN_RISE and float(jnp.max(rise)) == ehl._MAX_RISE
+    assert float(jnp.min(rise)) == _MIN_RISE and float(jnp.max(rise)) == _MAX_RISE
     for inlet in (200.0, 600.0):
         t = inlet + rise
         for p in (0.0, 3e9):

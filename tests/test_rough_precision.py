@@ -1,5 +1,5 @@
 """The Newton matrix of a deterministic rough film is factorised in single precision from 257 nodes
-(``ehl._MIXED_PRECISION_NODES_ROUGH``; 513 for smooth and statistical films), each direction
+(``ehl.newton._MIXED_PRECISION_NODES_ROUGH``; 513 for smooth and statistical films), each direction
 refined against the float64 matrix and the convergence test kept on the float64 residual: the
 path to the solution may change, the solution it converges to should not."""
 
@@ -11,7 +11,9 @@ import pytest
 from ehl_cases import gear_contact
 
 import jaxgear as jg
-from jaxgear.lubrication import ehl
+from jaxgear.lubrication.ehl import newton
+from jaxgear.lubrication.ehl.discretisation import _fine_level, _grid_positions
+from jaxgear.lubrication.ehl.model import _Inputs
 from jaxgear.lubrication.roughness import ground
 
 LUB = jg.presets.mil_l_23699()
@@ -22,16 +24,16 @@ def test_only_rough_films_take_the_single_precision_lu_at_257_nodes():
     # level an attempt builds from them (``dataclasses.replace``/``eqx.tree_at`` keep it)
     model = jg.EHLModel(n_nodes=257)
     c = gear_contact(rpm=3500.0)
-    x = ehl._grid_positions(model, c, LUB)
+    x = _grid_positions(model, c, LUB)
     z = np.zeros(x.shape)
-    inp = ehl._Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()))
-    assert not ehl._mixed_precision(ehl._fine_level(model, inp)[1])
+    inp = _Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()))
+    assert not newton._mixed_precision(_fine_level(model, inp)[1])
     rough = dataclasses.replace(inp, rough=True)
-    assert ehl._mixed_precision(ehl._fine_level(model, rough)[1])
+    assert newton._mixed_precision(_fine_level(model, rough)[1])
     coarse = jg.EHLModel(n_nodes=129)
     z = np.zeros(129)
-    small = ehl._Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()), rough=True)
-    assert not ehl._mixed_precision(ehl._fine_level(coarse, small)[1])
+    small = _Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()), rough=True)
+    assert not newton._mixed_precision(_fine_level(coarse, small)[1])
 
 
 @pytest.mark.parametrize("rpm", [3500.0, pytest.param(500.0, marks=pytest.mark.slow)])
@@ -45,8 +47,8 @@ def test_single_precision_lu_reaches_the_double_lu_film(rpm, monkeypatch):
     c = gear_contact(rpm=rpm)
     model = jg.EHLModel(n_nodes=257, mixed="deterministic")
     traced = []  # the single-precision solves the compiled program holds (counted when traced)
-    refined = ehl._refined
-    monkeypatch.setattr(ehl, "_refined", lambda *a: traced.append(1) or refined(*a))
+    refined = newton._refined
+    monkeypatch.setattr(newton, "_refined", lambda *a: traced.append(1) or refined(*a))
 
     def solve():
         traced.clear()
@@ -55,7 +57,7 @@ def test_single_precision_lu_reaches_the_double_lu_film(rpm, monkeypatch):
         return sol, len(traced)
 
     single, n_single = solve()
-    monkeypatch.setattr(ehl, "_MIXED_PRECISION_NODES_ROUGH", 10**9)
+    monkeypatch.setattr(newton, "_MIXED_PRECISION_NODES_ROUGH", 10**9)
     double, n_double = solve()
     jax.clear_caches()
     assert n_single > 0 and n_double == 0, (n_single, n_double)

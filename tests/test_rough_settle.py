@@ -1,7 +1,7 @@
 """Deep mixed steady films by pseudo-transient continuation, the last attempt of ``solve_ehl`` for a
-deterministic rough film (``ehl._pseudo_march``, issue 4): where the direct steady solve fails, a
-march in pseudo-time with the roughness held reaches a state from which the steady solve
-converges, inside the compiled solve."""
+deterministic rough film (``ehl.continuation._pseudo_march``, issue 4): where the direct steady
+solve fails, a march in pseudo-time with the roughness held reaches a state from which the steady
+solve converges, inside the compiled solve."""
 
 import jax.numpy as jnp
 import numpy as np
@@ -9,7 +9,10 @@ import pytest
 from ehl_cases import gear_contact
 
 import jaxgear as jg
-from jaxgear.lubrication import ehl
+from jaxgear.lubrication.ehl import discretisation
+from jaxgear.lubrication.ehl.continuation import _with_pseudo_squeeze
+from jaxgear.lubrication.ehl.discretisation import _grid_positions
+from jaxgear.lubrication.ehl.model import _Inputs
 from jaxgear.lubrication.roughness import ground
 
 LUB = jg.presets.mil_l_23699()
@@ -17,13 +20,13 @@ LUB = jg.presets.mil_l_23699()
 
 def _fine_level(n=65, transient=True):
     c = gear_contact(rpm=3500.0)
-    x = ehl._grid_positions(jg.EHLModel(n_nodes=n), c, LUB)
+    x = _grid_positions(jg.EHLModel(n_nodes=n), c, LUB)
     rng = np.random.default_rng(3)
     rho_h_prev = jnp.asarray(850.0 * 1e-7 * (1.0 + 0.2 * rng.random(n)))
     inv_dt = jnp.asarray(2.0e5 if transient else 0.0)
     z = jnp.zeros(n)
-    inp = ehl._Inputs(c, LUB, rho_h_prev, inv_dt, 1e-7 * jnp.sin(x / 1e-5), z, z, jnp.zeros(()))
-    return ehl._fine_level(jg.EHLModel(n_nodes=n, mixed="deterministic"), inp)[1]
+    inp = _Inputs(c, LUB, rho_h_prev, inv_dt, 1e-7 * jnp.sin(x / 1e-5), z, z, jnp.zeros(()))
+    return discretisation._fine_level(jg.EHLModel(n_nodes=n, mixed="deterministic"), inp)[1]
 
 
 @pytest.mark.parametrize("transient", [False, True])
@@ -39,10 +42,10 @@ def test_pseudo_squeeze_is_a_backward_euler_term_added_to_the_problem(transient)
     h = jnp.asarray(0.3 + 0.5 * level.x**2 + 0.05 * rng.random(n))
     rho_h_state = level.density(p) * (h + 0.02 * jnp.cos(3.0 * level.x))
     r0, _ = level.reynolds(p, h, 1.0)
-    same = ehl._with_pseudo_squeeze(level, jnp.asarray(0.0), rho_h_state)
+    same = _with_pseudo_squeeze(level, jnp.asarray(0.0), rho_h_state)
     assert np.array_equal(np.asarray(same.reynolds(p, h, 1.0)[0]), np.asarray(r0))
     sigma = jnp.asarray(37.0)
-    r1, _ = ehl._with_pseudo_squeeze(level, sigma, rho_h_state).reynolds(p, h, 1.0)
+    r1, _ = _with_pseudo_squeeze(level, sigma, rho_h_state).reynolds(p, h, 1.0)
     expected = r0 - sigma * (level.density(p) * h - rho_h_state)
     # interior nodes (the boundary entries are replaced by the Dirichlet rows); rounding only
     scale = float(jnp.max(jnp.abs(expected[1:-1])))

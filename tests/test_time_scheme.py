@@ -359,7 +359,7 @@ def test_film_at_the_feet_reads_the_roughness_where_it_stood():
     # interpolated (error ~Δx² g''/8, 1e-3 of the bump here), the roughness evaluated from the
     # profile, so the reading is exact to 1 % of the bump; interpolating ρh itself flattens the bump
     # (the test would see it: its error is 29 % of the bump here)
-    from jaxgear.lubrication.ehl import _film_at_feet, _roughness_offset
+    from jaxgear.lubrication.ehl.discretisation import _film_at_feet, _roughness_offset
 
     b, amplitude = 200e-6, 0.5e-6
     surf = bump_surfaces(b, amplitude=amplitude, width=3e-6, start=-0.3)
@@ -405,7 +405,7 @@ def test_a_grown_grid_reads_the_earlier_film_upstream_of_its_inlet_with_the_rigi
     # v a slowly varying deformation (linear far upstream) and ρ the inlet's: read there within
     # 1e-3 of its gap growth (the deformation's curvature, 1e-4 of the gap, is what linear
     # extrapolation misses); held at the first node's value, as before, 30 % of it short
-    from jaxgear.lubrication.ehl import _film_at_feet
+    from jaxgear.lubrication.ehl.discretisation import _film_at_feet
 
     b, radius, rho0 = 300e-6, 0.013, 870.0
     x_prev = jnp.linspace(-4.5 * b, 1.5 * b, 257)

@@ -37,19 +37,11 @@ import jax.numpy as jnp
 from .._validation import is_concrete
 from ..material import steel
 from . import thermal as thermal_mod
-from .ehl import (
-    EHLModel,
-    EHLSolution,
-    LineContact,
-    _film_at_feet,
-    _grid_positions,
-    _Inputs,
-    _roughness_offset,
-    _solve_impl,
-    _split_numbers,
-    _warm_args,
-    transport_shift,
-)
+from .ehl import EHLModel, EHLSolution, LineContact, transport_shift
+from .ehl.discretisation import _film_at_feet, _grid_positions, _roughness_offset
+from .ehl.model import _Inputs, _split_numbers
+from .ehl.outer import _solve_impl
+from .ehl.starts import _warm_args
 from .lubricant import Lubricant
 from .roughness import Surfaces
 
@@ -157,8 +149,8 @@ def _temperature_start(mixed, prev, x, inlet, shift):
     moved by 0.7 % at 3500 rpm, 0.1 % at 2000 rpm: which discrete solution a step lands on). Smooth
     and statistical films, whose temperatures vary over the Hertz width, keep the unshifted start.
     Measured earlier the same day, before a failed warm re-solve continued in the temperature
-    (``ehl._temperature_continuation``), the same start cost more: 211 631 against 141 633
-    iterations, when a re-solve that failed fell back to the cold solve.
+    (``ehl.continuation._temperature_continuation``), the same start cost more: 211 631 against
+    141 633 iterations, when a re-solve that failed fell back to the cold solve.
     Tried and not kept (3500 rpm, same code otherwise): a continuation in the share of the time
     step for a first solve whose warm Newton failed (roughness, squeeze term and temperatures
     together from the previous step's solution): 87 Newton iterations a solve, 281 of 299
@@ -515,8 +507,9 @@ def solve_ehl_passage(
     solids = (steel(), steel()) if solids is None else tuple(solids)
     mixed = "smooth" if surfaces is None else model.mixed
     # the steps of a passage do not end in the pseudo-time march of a steady deterministic film
-    # (``ehl._pseudo_march``): measured on one engagement (257 nodes, 3500 rpm, 2026-11-27), it
-    # did not rescue the one step that failed, and it made the engagement cost 49 s against 33 s
+    # (``ehl.continuation._pseudo_march``): measured on one engagement (257 nodes, 3500 rpm,
+    # 2026-11-27), it did not rescue the one step that failed, and it made the engagement cost
+    # 49 s against 33 s
     model = dataclasses.replace(model, pseudo_transient_steps=0)
     sols, worn = _passage(
         model,
