@@ -98,9 +98,7 @@ def test_reverse_gradient_matches_forward_mode_and_central_differences(reverse_a
 
 
 def _counted_first_pass(monkeypatch):
-    fresh = eqx.filter_jit(
-        eqx.debug.assert_max_traces(passes._first_pass_outputs, max_traces=1)
-    )
+    fresh = eqx.filter_jit(eqx.debug.assert_max_traces(passes._first_pass_outputs, max_traces=1))
     monkeypatch.setattr(passes, "_first_pass_jit", fresh)
 
 
@@ -178,3 +176,38 @@ def test_a_failed_implicit_solve_gives_nan_derivatives_not_an_exception():
         jax.block_until_ready(
             jax.jvp(lambda a: solve(a, optx.ImplicitAdjoint(linear_solver=plain)), *one)
         )
+
+
+# The paper's model at reduced resolution (thermal, statistical mixed, transient, tribo-dynamic;
+# 24 positions, 65 nodes): its contacts carry outer (Picard) iterations for the film temperature
+# and the asperity pressure that stop at 1 % of the temperature rise and 1e-3 ph, so Ψ follows its
+# inputs smoothly only to those tolerances: the differences take a 1 % step of each value and must
+# agree within 5 % (a missed dependence or a wrong implicit rule is off by far more).
+PAPER_CHECKED = (CHECKED[0], CHECKED[5], CHECKED[6])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("index", range(len(PAPER_CHECKED)), ids=[c[0] for c in PAPER_CHECKED])
+def test_paper_fidelity_reverse_gradient_matches_forward_and_differences(index):
+    label, get, _ = PAPER_CHECKED[index]
+    fid = jg.Fidelity.paper(n_positions=24, n_nodes=65, fixed_point_tolerance=1e-6)
+    inputs = (PAIR, SURF, OP, fid)
+    params, static = _split(inputs)
+
+    def psi(p):
+        return _efficiency(eqx.combine(p, static))
+
+    value, grads = jax.value_and_grad(psi)(params)
+    assert 0.99 < float(value) < 1.0
+    assert all(bool(jnp.all(jnp.isfinite(g))) for g in jax.tree_util.tree_leaves(grads))
+    reverse = float(jnp.sum(get(grads)))
+    forward = float(jax.jvp(psi, (params,), (_direction(inputs, get),))[1])
+    assert reverse == pytest.approx(forward, rel=1e-6, abs=1e-14), label
+    x = get(inputs)
+    h = 1e-2 * float(jnp.max(jnp.abs(x)))
+
+    def at(shift):
+        return float(_efficiency(eqx.tree_at(get, inputs, x + shift)))
+
+    fd = (at(h) - at(-h)) / (2.0 * h)
+    assert reverse == pytest.approx(fd, rel=5e-2, abs=1e-12), (label, reverse, fd)
