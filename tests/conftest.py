@@ -1,3 +1,5 @@
+import os
+
 import jax
 import pytest
 
@@ -6,18 +8,52 @@ from jaxgear.cli import enable_compilation_cache
 # Tests run in float64 (EHL needs it); the library never flips this itself.
 jax.config.update("jax_enable_x64", True)
 # Compiled programs on disk from the first test on, as `jaxgear` keeps them ($JAXGEAR_CACHE_DIR,
-# default ~/.cache/jaxgear/xla; "off" disables). The suite compiles the same programs in many
-# modules (each module's in-memory programs are dropped when it ends, below). Before, only the
-# in-process `jaxgear run` test switched the cache on, halfway through one worker's share: a run
-# then took 30 min with an empty cache and 17 min with the one the previous run had left.
+# default ~/.cache/jaxgear/xla; "off" disables).
 enable_compilation_cache()
 
 
+def _read(path: str) -> str:
+    try:
+        with open(path) as f:
+            return f.read()
+    except OSError:
+        return ""
+
+
+def _memory_maps() -> int:
+    return _read(f"/proc/{os.getpid()}/maps").count("\n")
+
+
+def _resident_bytes() -> int:
+    for line in _read(f"/proc/{os.getpid()}/status").splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) * 1024
+    return 0
+
+
+def _physical_bytes() -> int:
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError):
+        return 8 << 30
+
+
+# Compiled programs stay in memory across test modules: a program compiled in one module is reused
+# by the next without tracing and compiling it again. They are dropped only when a worker holds a
+# quarter of the machine's memory or half of the kernel's limit on memory maps (vm.max_map_count;
+# XLA's CPU executables map memory of their own): a full run that never released them aborted
+# inside a compilation near its end ("Fatal Python error: Aborted").
+_MAP_BUDGET = (int(_read("/proc/sys/vm/max_map_count") or 65530)) // 2
+_MEMORY_BUDGET = _physical_bytes() // 4
+
+
 @pytest.fixture(autouse=True, scope="module")
-def _release_compiled_programs():
-    """Drop each test module's compiled programs when it ends, so a full run does not hold every
-    program it compiled. One full default run aborted ("Fatal Python error: Aborted") inside a
-    compilation near its end without this; with it the run completes. The cause was not
-    established (the process's memory-map count is a suspect: XLA maps memory per executable)."""
+def _release_compiled_programs_near_the_limits(request):
     yield
-    jax.clear_caches()
+    maps, resident = _memory_maps(), _resident_bytes()
+    log = os.environ.get("JAXGEAR_TEST_MAPS_LOG")
+    if log:  # what each test module leaves behind, to check the budgets against
+        with open(log, "a") as f:
+            f.write(f"{os.getpid()} {request.module.__name__} {maps} {resident >> 20}\n")
+    if maps > _MAP_BUDGET or resident > _MEMORY_BUDGET:
+        jax.clear_caches()
