@@ -39,7 +39,7 @@ from ehl_cases import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 from jaxgear.lubrication.ehl.discretisation import _fine_level, _grid_positions  # noqa: E402
-from jaxgear.lubrication.ehl.model import _Inputs  # noqa: E402
+from jaxgear.lubrication.ehl.model import _Inputs, _split_numbers  # noqa: E402
 from jaxgear.lubrication.passage import grid_time_step  # noqa: E402
 from jaxgear.paper import field_surfaces  # noqa: E402
 
@@ -70,8 +70,9 @@ def _system(n, kind):
             surf.displaced_height(0, x, displacement[0])
             + surf.displaced_height(1, x, displacement[1])
         )
-        inp = _Inputs(contact, LUB, rho_h, inv_dt, offset, zero, zero, surf.composite_rq)
-        return _fine_level(model, dataclasses.replace(inp, rough=True))[1]
+        numbers, static = _split_numbers(model)
+        inp = _Inputs(contact, LUB, rho_h, inv_dt, offset, zero, zero, surf.composite_rq, numbers)
+        return _fine_level(static, dataclasses.replace(inp, rough=True))[1]
 
     steady, step = level(jnp.zeros(2), None), level(moved, first)
     film_unit = float(steady.sc.b**2 / contact.reduced_radius)

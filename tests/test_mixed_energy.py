@@ -108,7 +108,7 @@ def test_statistical_thermal_heat_equals_friction_work(statistical_film):
     f = _fields(sol, c)
     x, b = f["x"], f["b"]
     us = abs(f["u1"] - f["u2"])
-    mu_b = STAT_THERMAL.boundary_friction
+    mu_b = float(STAT_THERMAL.boundary_friction)
     assert float(sol.temperature.max() - c.inlet_temperature) > 1.0  # a thermal film
 
     # the discrete Reynolds equation conserves mass: the flux through the pressurised film is one
@@ -185,7 +185,7 @@ def test_deterministic_thermal_heat_equals_friction_work(deterministic_film):
     f = _fields(sol, c)
     x = f["x"]
     us = abs(f["u1"] - f["u2"])
-    mu_b = DET_THERMAL.boundary_friction
+    mu_b = float(DET_THERMAL.boundary_friction)
     assert float(sol.temperature.max() - c.inlet_temperature) > 10.0
     assert float(sol.contact_load_share) > 0.01
 

@@ -153,7 +153,7 @@ def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_st
 
     from jaxgear.lubrication.ehl.continuation import _rough_homotopy
     from jaxgear.lubrication.ehl.discretisation import _grid_positions, _levels
-    from jaxgear.lubrication.ehl.model import _Inputs
+    from jaxgear.lubrication.ehl.model import _Inputs, _split_numbers
     from jaxgear.lubrication.ehl.newton import _newton
     from jaxgear.lubrication.ehl.starts import _cold_start, _schedules
 
@@ -168,6 +168,7 @@ def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_st
     d = np.asarray([float(c.u1), float(c.u2)]) * dt
     offset = -(surf.displaced_height(0, x, d[0]) + surf.displaced_height(1, x, d[1]))
     zero = jnp.zeros_like(x)
+    numbers, model = _split_numbers(model)
     inp = _Inputs(
         c,
         LUB,
@@ -177,6 +178,7 @@ def test_rough_cold_solve_of_a_transient_step_starts_from_a_consistent_smooth_st
         zero,
         zero,
         surf.composite_rq,
+        numbers,
     )
     _, levels = _levels(model, inp)
     fine = levels[-1]

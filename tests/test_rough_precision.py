@@ -13,7 +13,7 @@ from ehl_cases import gear_contact
 import jaxgear as jg
 from jaxgear.lubrication.ehl import newton
 from jaxgear.lubrication.ehl.discretisation import _fine_level, _grid_positions
-from jaxgear.lubrication.ehl.model import _Inputs
+from jaxgear.lubrication.ehl.model import _Inputs, _split_numbers
 from jaxgear.lubrication.roughness import ground
 
 LUB = jg.presets.mil_l_23699()
@@ -22,17 +22,17 @@ LUB = jg.presets.mil_l_23699()
 def test_only_rough_films_take_the_single_precision_lu_at_257_nodes():
     # the flag that selects it is set on the inputs by the deterministic solve and must reach every
     # level an attempt builds from them (``dataclasses.replace``/``eqx.tree_at`` keep it)
-    model = jg.EHLModel(n_nodes=257)
+    numbers, model = _split_numbers(jg.EHLModel(n_nodes=257))
     c = gear_contact(rpm=3500.0)
     x = _grid_positions(model, c, LUB)
     z = np.zeros(x.shape)
-    inp = _Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()))
+    inp = _Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()), numbers)
     assert not newton._mixed_precision(_fine_level(model, inp)[1])
     rough = dataclasses.replace(inp, rough=True)
     assert newton._mixed_precision(_fine_level(model, rough)[1])
-    coarse = jg.EHLModel(n_nodes=129)
+    numbers, coarse = _split_numbers(jg.EHLModel(n_nodes=129))
     z = np.zeros(129)
-    small = _Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()), rough=True)
+    small = _Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()), numbers, rough=True)
     assert not newton._mixed_precision(_fine_level(coarse, small)[1])
 
 

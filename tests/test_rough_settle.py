@@ -12,7 +12,7 @@ import jaxgear as jg
 from jaxgear.lubrication.ehl import discretisation
 from jaxgear.lubrication.ehl.continuation import _with_pseudo_squeeze
 from jaxgear.lubrication.ehl.discretisation import _grid_positions
-from jaxgear.lubrication.ehl.model import _Inputs
+from jaxgear.lubrication.ehl.model import _Inputs, _split_numbers
 from jaxgear.lubrication.roughness import ground
 
 LUB = jg.presets.mil_l_23699()
@@ -25,8 +25,10 @@ def _fine_level(n=65, transient=True):
     rho_h_prev = jnp.asarray(850.0 * 1e-7 * (1.0 + 0.2 * rng.random(n)))
     inv_dt = jnp.asarray(2.0e5 if transient else 0.0)
     z = jnp.zeros(n)
-    inp = _Inputs(c, LUB, rho_h_prev, inv_dt, 1e-7 * jnp.sin(x / 1e-5), z, z, jnp.zeros(()))
-    return discretisation._fine_level(jg.EHLModel(n_nodes=n, mixed="deterministic"), inp)[1]
+    numbers, model = _split_numbers(jg.EHLModel(n_nodes=n, mixed="deterministic"))
+    offset = 1e-7 * jnp.sin(x / 1e-5)
+    inp = _Inputs(c, LUB, rho_h_prev, inv_dt, offset, z, z, jnp.zeros(()), numbers)
+    return discretisation._fine_level(model, inp)[1]
 
 
 @pytest.mark.parametrize("transient", [False, True])
