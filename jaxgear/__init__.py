@@ -9,6 +9,7 @@ the library never changes ``jax.config`` itself.
 from . import paper as figures  # the former name of jaxgear.paper
 from . import paper as paper
 from . import presets as presets
+from . import results as results
 from . import units as units
 from .gear.geometry import GearGeometry as GearGeometry
 from .gear.geometry import gear_geometry as gear_geometry
@@ -52,6 +53,7 @@ from .optimise import optimise as optimise_bounded
 from .optimise import optimise_roughness_scale as optimise_roughness_scale
 from .optimise import optimise_tip_relief as optimise_tip_relief
 from .optimise import optimise_torque as optimise_torque
+from .results import Status as Status
 from .sweep import SweepResult as SweepResult
 from .sweep import sweep as sweep
 from .tribodynamics import SimulationResult as SimulationResult

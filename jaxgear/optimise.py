@@ -49,20 +49,20 @@ from .fidelity import Fidelity
 from .gear.geometry import gear_geometry
 from .gear.pair import RELIEF_SHAPES, GearPair, TipRelief
 from .operating import OperatingPoint
+from .results import MESSAGES, Status
 from .tribodynamics import check_inputs, first_pass
 
-# Status codes of an optimisation.
-STATUS_CONVERGED = 0  # projected gradient below tolerance
-STATUS_MAX_STEPS = 1  # step cap reached before the gradient tolerance
-STATUS_SIMULATION = 2  # a step landed on a non-converged simulation point: stopped there
-STATUS_START = 3  # the start point itself did not converge: nothing done
-STATUS_NON_FINITE = 4  # non-finite objective or gradient
+# Status codes of an optimisation (``results.Status``).
+STATUS_CONVERGED = Status.OK  # projected gradient below tolerance
+STATUS_MAX_STEPS = Status.MAX_STEPS  # step cap reached before the gradient tolerance
+STATUS_SIMULATION = Status.SIMULATION  # a step landed on a non-converged simulation point
+STATUS_START = Status.START  # the start point itself did not converge: nothing done
+STATUS_NON_FINITE = Status.NON_FINITE  # non-finite objective or gradient
+#: The codes an OptimisationResult can carry → their messages.
 STATUS_NAMES = {
-    STATUS_CONVERGED: "converged (projected gradient below tolerance)",
-    STATUS_MAX_STEPS: "step cap reached before the gradient tolerance",
-    STATUS_SIMULATION: "stopped: a simulation point did not converge (best converged point kept)",
-    STATUS_START: "the start point did not converge; nothing optimised",
-    STATUS_NON_FINITE: "stopped: non-finite objective or gradient (best finite point kept)",
+    int(Status.OK): "converged (projected gradient below tolerance)",
+    **{int(code): MESSAGES[code] for code in (STATUS_MAX_STEPS, STATUS_SIMULATION, STATUS_START)},
+    int(Status.NON_FINITE): "stopped: non-finite objective or gradient (best finite point kept)",
 }
 
 DEFAULT_RELIEF_AMOUNT_BOUNDS = (0.0, 50e-6)  # m

@@ -109,7 +109,7 @@ def test_a_wrong_load_torque_is_rebalanced_to_nominal_mean_speed():
 def test_flip_band_settles_on_a_period_two_rattle_with_the_moment_balance():
     orbit = _orbit(800.0)
     # the period-1 orbit exists but is unstable (largest |Floquet multiplier| 1.11, a real −1.11)
-    assert int(orbit.status) == 3 and float(orbit.floquet_multiplier) > 1.05
+    assert int(orbit.status) == jg.Status.UNSTABLE and float(orbit.floquet_multiplier) > 1.05
     att = _attractor(800.0, orbit.initial_state, 2000, 32)
     assert int(att.period) == 2
     assert float(att.contact_loss) > 0.1  # the teeth separate: a rattle, not a small oscillation

@@ -54,7 +54,7 @@ def _jump_case():
     """Light load (static mesh deflection 9.5 µm) and a 5 µm TE excitation near the first mesh mode:
     the teeth separate near resonance. Bearing damping raised (cy 8000 N s/m, ct 15 N m s/rad) so the
     periodic orbits stay stable (with the paper's lighter damping this case goes on to period doubling,
-    which the result flags as status 3)."""
+    which the result flags as status 8, UNSTABLE)."""
     base = jg.presets.li2015_pair()
     pair = eqx.tree_at(lambda p: p.bearings, base, Bearings(cy=8000.0, ct=15.0))
     torque = 150.0

@@ -285,7 +285,7 @@ def test_cli_optimise_json_and_png(tmp_path, capsys):
     assert 0.0 <= opt["tip_relief_amount_um"] <= 50.0
     assert 15.0 < opt["tip_relief_start_roll_angle_deg"] < 26.6
     assert data["efficiency_optimum_percent"] >= data["efficiency_start_percent"]
-    assert data["status_name"] and data["status"] in (0, 1)
+    assert data["status_name"] and data["status"] in (jg.Status.OK, jg.Status.MAX_STEPS)
     assert data["efficiency_start_percent"] == pytest.approx(
         100 * mean_efficiency(10e-6, math.radians(20.9)), abs=1e-10
     )

@@ -251,7 +251,7 @@ def attractor_response(
 ) -> AttractorRecord:
     """The steady response of ``pair`` at ``op`` by time integration, with no periodicity assumed.
 
-    Use it where ``dynamic_response`` reports no stable periodic orbit (status 1 or 3): the gears
+    Use it where ``dynamic_response`` reports no stable periodic orbit (status 2 or 8: not converged or unstable): the gears
     then settle elsewhere, and this records where. Weak instabilities (largest Floquet multiplier
     1 + ε) leave the orbit over ~ln(1/kick)/ε cycles, so ``settle_periods`` must exceed that.
 

@@ -24,6 +24,7 @@ from .._validation import check_instance, check_positive, is_concrete
 from ..gear.mesh import mesh_cycle
 from ..gear.pair import GearPair
 from ..operating import OperatingPoint
+from ..results import Status
 from .integrate import PeriodFlow
 from .model import DynamicsOptions, GearDynamics, MeshInterface, build_dynamics
 from .shooting import STABILITY_TOL, OrbitStats, periodic_orbit, static_guess
@@ -31,10 +32,11 @@ from .shooting import STABILITY_TOL, OrbitStats, periodic_orbit, static_guess
 #: Mesh harmonics in the DTE RMS (REFERENCE §7 R1).
 N_HARMONICS = 10
 
-STATUS_CONVERGED = 0
-STATUS_NOT_CONVERGED = 1
-STATUS_NOT_FINITE = 2
-STATUS_UNSTABLE = 3
+# Status codes of a DynamicResponse (``results.Status``).
+STATUS_CONVERGED = Status.OK
+STATUS_NOT_CONVERGED = Status.DYNAMICS
+STATUS_NOT_FINITE = Status.NON_FINITE
+STATUS_UNSTABLE = Status.UNSTABLE
 
 
 class DynamicResponse(eqx.Module):
@@ -56,8 +58,8 @@ class DynamicResponse(eqx.Module):
         dte_rms: √(Σq εd,q²), m (REFERENCE §7 R1).
         converged: Newton met ``newton_tol``; stable: all Floquet multipliers |μ| ≤ 1 + 1e-6 (an
         unstable periodic orbit is a solution that the real gears would leave);
-        floquet_multiplier: the largest |μ|; status: 0 converged and stable, 1 Newton did not
-        converge, 2 not finite, 3 converged to an unstable orbit; newton_iterations,
+        floquet_multiplier: the largest |μ|; status (``results.Status``): 0 converged and stable,
+        2 Newton did not converge, 4 not finite, 8 converged to an unstable orbit; newton_iterations,
         periodicity_residual: max |z(Tm) − z(0)| / max |z| of the returned orbit (dimensionless).
         initial_state: the shooting unknowns [13] (scaled state at τ = 0 and s), reusable as a guess.
         back_force: the back flanks' force alone (≤ 0, N) [M]: part of ``mesh_force``, apart
@@ -93,8 +95,6 @@ class DynamicResponse(eqx.Module):
     initial_state: Float[Array, " 13"]
     back_force: Float[Array, " M"]
     mesh_damping_power: Float[Array, ""]
-
-
 
 
 def _safe_abs_complex(c):
@@ -142,9 +142,7 @@ def postprocess(
     """The DynamicResponse of the orbit ``w`` [13] with its ``PeriodFlow`` and shooting stats."""
     zs = flow.positions
     resid = jnp.max(jnp.abs(flow.final - w[:12])) / jnp.maximum(jnp.max(jnp.abs(zs)), 1e-30)
-    displacement, velocity, dte, (d, d_back), (fm, f_back), tooth, surf = _kinematics(
-        dyn, mesh, zs
-    )
+    displacement, velocity, dte, (d, d_back), (fm, f_back), tooth, surf = _kinematics(dyn, mesh, zs)
     harm = dte_harmonic_amplitudes(dte)
     rms = jnp.sqrt(jnp.sum(harm**2))
     finite = jnp.all(jnp.isfinite(zs)) & jnp.all(jnp.isfinite(flow.final)) & jnp.isfinite(rms)
@@ -366,4 +364,3 @@ def dynamic_response_sweep(
     raise ValueError(
         f"mode = {mode!r} is not valid; valid choices: 'parallel', 'continuation', 'up_down'"
     )
-

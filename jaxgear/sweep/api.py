@@ -21,9 +21,9 @@ from .._validation import check_non_negative, check_positive, check_range
 from ..fidelity import Fidelity
 from ..gear.pair import MAX_RELIEF_PER_MODULE
 from ..operating import OperatingPoint
+from ..results import Status, messages
 from ..tribodynamics import (
     STATUS_ATTRACTOR,
-    STATUS_NAMES,
     STATUS_PENDING,
     check_inputs,
     cold_start,
@@ -75,7 +75,7 @@ class SweepResult(eqx.Module):
         power_loss_position: Φ(t_i) per point, W [N, M].
         tooth_force: W_T per point, position and pair slot, N [N, M, 2]; surface_velocity: uj, m/s
             [N, M, 2, 2]; hertz_pressure: Hertz pressure of W_T, Pa [N, M, 2] (as in SimulationResult).
-        status: per point, the simulation status (0 ok; see ``tribodynamics.STATUS_NAMES``), or 5 where
+        status: per point, the simulation status (0 ok; ``jaxgear.results.Status``), or 5 (FAILED) where
             the point's chunk raised or its outputs were not finite.
         converged: status == 0; on_attractor: status 6 (no stable periodic orbit: means over the
             attractor); failed: neither.
@@ -116,8 +116,8 @@ class SweepResult(eqx.Module):
         return ~self.converged & ~self.on_attractor
 
     def status_names(self) -> list[str]:
-        names = {**STATUS_NAMES, 5: "failed (chunk raised or non-finite)"}
-        return [names.get(int(s), str(int(s))) for s in np.asarray(self.status)]
+        """Each point's status in words (``jaxgear.results``)."""
+        return messages(self.status)
 
     def to_csv(self, path: str | Path) -> Path:
         """One row per point; SI except speed (rpm), efficiency (%), DTE (µm), temperature (°C)."""
@@ -360,7 +360,9 @@ def sweep(
             label="continuation",
         )
     out = _second_pass(dict(raw.outputs), raw.status, inputs, shared, mode == "continuation")
-    status = np.where(raw.status >= 2, 5, np.asarray(out["sim_status"])).astype(np.int32)
+    status = np.where(raw.status >= 2, Status.FAILED, np.asarray(out["sim_status"])).astype(
+        np.int32
+    )
     return SweepResult(
         inputs=inputs,
         power_loss=np.asarray(out["power_loss"]),

@@ -59,7 +59,7 @@ def _deferred_result(pair, op, pending: Pending, fidelity: Fidelity) -> Simulati
         pending.strikes_back & ~unstable & (result.status == 0), STATUS_PENDING, result.status
     )
     status = jnp.where(unstable & (status == 0), STATUS_DYNAMICS, status).astype(jnp.int32)
-    result = eqx.tree_at(lambda r: (r.status, r.converged), result, (status, status == 0))
+    result = eqx.tree_at(lambda r: r.status, result, status)
     return without_derivative_where(result, needs_second_pass(pending, fidelity))
 
 

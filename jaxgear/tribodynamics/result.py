@@ -11,24 +11,29 @@ from ..contact.base import safe_sqrt
 from ..dynamics.response import dte_harmonic_amplitudes
 from ..material import reduced_modulus
 from ..power_loss import cycle_mean, efficiency, total_per_position
+from ..results import MESSAGES, Status, message
 
-# Status codes of a simulation (0 is success; the first failure found, in this order, is reported).
-STATUS_OK = 0
-STATUS_FIXED_POINT = 1  # tribo-dynamic fixed point did not reach its tolerance
-STATUS_DYNAMICS = 2  # periodic orbit not converged or unstable
-STATUS_CONTACT = 3  # a contact solve did not converge
-STATUS_NON_FINITE = 4
-# 5 is the sweep's own "chunk raised or non-finite" (sweep.SweepResult)
-STATUS_ATTRACTOR = 6  # no stable periodic orbit: means over the attractor reached in time
-STATUS_PENDING = 7  # first pass only: the orbit strikes the back flanks (their loss comes later)
+# Status codes of a simulation (``results.Status``; 0 is success; the first failure found, in this
+# order, is reported).
+STATUS_OK = Status.OK
+STATUS_FIXED_POINT = Status.FIXED_POINT  # tribo-dynamic fixed point did not reach its tolerance
+STATUS_DYNAMICS = Status.DYNAMICS  # periodic orbit not converged or unstable
+STATUS_CONTACT = Status.CONTACT  # a contact solve did not converge
+STATUS_NON_FINITE = Status.NON_FINITE
+STATUS_ATTRACTOR = Status.ATTRACTOR  # no stable periodic orbit: means over the attractor
+STATUS_PENDING = Status.PENDING  # first pass only: the orbit strikes the back flanks
+#: The codes a SimulationResult can carry → their messages.
 STATUS_NAMES = {
-    STATUS_OK: "ok",
-    STATUS_FIXED_POINT: "tribo-dynamic fixed point not converged",
-    STATUS_DYNAMICS: "dynamic periodic orbit not converged or unstable",
-    STATUS_CONTACT: "contact solver not converged",
-    STATUS_NON_FINITE: "non-finite result",
-    STATUS_ATTRACTOR: "no stable periodic orbit: means over the attractor (time integration)",
-    STATUS_PENDING: "the orbit strikes the back flanks: their loss is left to the second pass",
+    int(code): MESSAGES[code]
+    for code in (
+        STATUS_OK,
+        STATUS_FIXED_POINT,
+        STATUS_DYNAMICS,
+        STATUS_CONTACT,
+        STATUS_NON_FINITE,
+        STATUS_ATTRACTOR,
+        STATUS_PENDING,
+    )
 }
 
 
@@ -47,7 +52,8 @@ class SimulationResult(eqx.Module):
         hertz_pressure: Hertz pressure of W_T per pair, Pa [M, 2].
         friction_coefficient: per pair [M, 2]; damping: cm per pair, N s/m [M, 2].
         dynamic_te: εd(t_i), m [M]; roll_angle: gear 1 roll angle of slot 0, rad [M].
-        converged: everything converged; status: 0 ok, else the first failure (see STATUS_NAMES);
+        status: 0 ok, else the first failure (``jaxgear.results.Status``, ``STATUS_NAMES``); converged
+            (a property): status 0;
             6 (STATUS_ATTRACTOR): the fixed point has no stable periodic orbit, and the values are
             means over the attractor the gears settle on (``Fidelity.attractor_periods``);
         fixed_point_residual: |T(y) − y| of the friction table F1 relative to its maximum, in the
@@ -86,7 +92,6 @@ class SimulationResult(eqx.Module):
     damping: Float[Array, "M 2"]
     dynamic_te: Float[Array, " M"]
     roll_angle: Float[Array, " M"]
-    converged: Bool[Array, ""]
     status: Int[Array, ""]
     fixed_point_residual: Float[Array, ""]
     fixed_point_iterations: Int[Array, ""]
@@ -94,6 +99,16 @@ class SimulationResult(eqx.Module):
     power_loss_back: Float[Array, ""]
     back_contact_share: Float[Array, ""]
     mesh_damping_power: Float[Array, ""]
+
+    @property
+    def converged(self) -> Bool[Array, "..."]:
+        """Everything converged: ``status`` is 0 (elementwise over a batch)."""
+        return self.status == STATUS_OK
+
+    @property
+    def message(self) -> str:
+        """The status in words (a single result)."""
+        return message(self.status)
 
 
 def hertz_pressure_of(pair, mesh, load):
@@ -143,7 +158,6 @@ def assemble(
         damping=forces.damping,
         dynamic_te=dte,
         roll_angle=mesh.roll_angle,
-        converged=status == STATUS_OK,
         status=jnp.asarray(status, dtype=jnp.int32),
         fixed_point_residual=jnp.asarray(residual, dtype=loss.dtype),
         fixed_point_iterations=jnp.asarray(iterations, dtype=jnp.int32),
@@ -187,5 +201,3 @@ def without_derivative_where(result: SimulationResult, flag) -> SimulationResult
         return leaf
 
     return jax.tree_util.tree_map(mark, result)
-
-

@@ -8,6 +8,8 @@ import equinox as eqx
 import jax.numpy as jnp
 from jaxtyping import Array, Bool, Float, Int
 
+from ...results import Status
+
 
 class EHLSolution(eqx.Module):
     """Result of ``solve_ehl``, SI units, per unit face width where forces or powers.
@@ -86,6 +88,11 @@ class EHLSolution(eqx.Module):
     residual: Float[Array, ""]
     iterations: Int[Array, ""]
     thermal_residual: Float[Array, ""]
+
+    @property
+    def status(self) -> Int[Array, "..."]:
+        """``jaxgear.results.Status``: 0 (OK) converged, 3 (CONTACT) not."""
+        return jnp.where(self.converged, Status.OK, Status.CONTACT).astype(jnp.int32)
 
     @property
     def temperatures(self):
