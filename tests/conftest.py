@@ -39,11 +39,13 @@ def _physical_bytes() -> int:
 
 
 # Compiled programs stay in memory across test modules: a program compiled in one module is reused
-# by the next without tracing and compiling it again. They are dropped only when a worker holds a
-# quarter of the machine's memory or half of the kernel's limit on memory maps (vm.max_map_count;
-# XLA's CPU executables map memory of their own): a full run that never released them aborted
-# inside a compilation near its end ("Fatal Python error: Aborted").
-_MAP_BUDGET = (int(_read("/proc/sys/vm/max_map_count") or 65530)) // 2
+# by the next without tracing and compiling it again. They are dropped when a worker holds a
+# quarter of the machine's memory or a quarter of the kernel's limit on memory maps
+# (vm.max_map_count): XLA's CPU executables map memory of their own, a heavy EHL module adds up to
+# ~34k maps, and a process at the limit cannot map more, so its next compilation aborts the
+# interpreter ("Fatal Python error: Aborted", what a full run that never released them did). A
+# quarter leaves room for the heaviest module on top.
+_MAP_BUDGET = (int(_read("/proc/sys/vm/max_map_count") or 65530)) // 4
 _MEMORY_BUDGET = _physical_bytes() // 4
 
 

@@ -352,3 +352,4 @@ def save_figures(repro: PaperReproduction, out_dir: str | Path) -> tuple[dict, d
         fig.savefig(path, dpi=100)
         plt.close(fig)
         written[n] = path
+    return written, skipped

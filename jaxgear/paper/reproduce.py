@@ -465,6 +465,7 @@ def _solve_contact(repro, result, index, i, slot, label, deterministic=False):
     sol = solve_ehl(contact, repro.lubricant, model, surfaces)
     if not bool(sol.converged):
         what += f"; NOT CONVERGED (residual {float(sol.residual):.1e})"
+    return sol, what, bool(model.thermal)
 
 
 def _mark(result, i, attractor="‡", failed="†"):
