@@ -123,7 +123,7 @@ def _row(label, r):
         return f"| {label} | {r['error']} | | | | | |"
     return (
         f"| {label} | {r['trace_s']:.1f} | {r['lower_s']:.1f} | {r['compile_s']:.1f} | "
-        f"{r['hlo_lines']:,} ({r['hlo_while']}) | {r['run_s'] * 1e3:.0f} | "
+        f"{r['hlo_lines']:,} ({r['hlo_while']}) | {r['run_s'] * 1e3:.0f} |"
     )
 
 
