@@ -1,4 +1,4 @@
-"""Transient passage of one contact through a sequence of states (issue 4, paper Eqs. 4-9).
+"""Transient passage of one contact through a sequence of states (paper Eqs. 4-9).
 
 A tooth pair's contact changes along the path of contact: load, radius of curvature and surface
 velocities follow the mesh position, and each surface's roughness moves with its own velocity. The
@@ -66,7 +66,7 @@ def _advect_to(temperature, x_old, feet, cubic=False, entering=True):
 
     Why past the outlet: the grid follows the Hertz width, so where the load rises fast its outlet
     moves further in a step than the material does, and material that stood past the earlier
-    grid's outlet enters this one. Read as 0 (the bulk temperature, as before 2026-11-28), it left
+    grid's outlet enters this one. Read as 0 (the bulk temperature), it would leave
     a cold dip in the solids behind the outlet: a load doubled in one step after 100 steps of
     Δx/ur (65 nodes, 2000 rpm, SRR 0.3, thermal smooth film, backward Euler) put the surfaces
     0.07-0.9 K above the bulk at the 4 nodes past the old outlet where the outlet had stood at
@@ -120,7 +120,7 @@ def _film_rise_at(x, x_old, rise_old, cubic):
     the end nodes extrapolated from them, up to one cell (held beyond).
 
     Why past the ends: the grid follows the Hertz width, so under a rising load its end nodes lie
-    past the previous step's. Read as 0 there (the inlet temperature, as before 2026-11-28), the
+    past the previous step's. Read as 0 there (the inlet temperature), the
     outlet node's ∂ϕm/∂t pulled its film towards the inlet temperature: under a load rising by
     30 % over 24 Δx/ur (129 nodes, 2000 rpm, thermal smooth film, BDF2) its temperature rise was
     0.12 K where the node two cells upstream had 2.8 K, and its error against Δt/16 fell only as
@@ -134,8 +134,8 @@ def _temperature_start(mixed, prev, x, inlet, shift):
     """The film temperature rise (K, on this step's nodes ``x``) a step's temperature iteration
     starts from: the previous step's solution ``prev``, and, with deterministic roughness, moved
     downstream by ``shift`` = ur Δt (the inlet at 0). Read as the film's ∂ϕm/∂t reads it past the
-    previous grid's outlet (``_advect_to``; 0 there before 2026-11-28, when the statistical
-    thermal engagement along the path at 3500 rpm gave 171.460 W against 171.371 W now: where the
+    previous grid's outlet (``_advect_to``; read as 0 there, the statistical
+    thermal engagement along the path at 3500 rpm gives 171.460 W against 171.371 W: where the
     updates stop within their 1 % tolerance, which puts that loss 0.3 % below the tight fixed
     point, 171.932 W, under either start).
 
@@ -507,9 +507,8 @@ def solve_ehl_passage(
     solids = (steel(), steel()) if solids is None else tuple(solids)
     mixed = "smooth" if surfaces is None else model.mixed
     # the steps of a passage do not end in the pseudo-time march of a steady deterministic film
-    # (``ehl.continuation._pseudo_march``): measured on one engagement (257 nodes, 3500 rpm,
-    # 2026-11-27), it did not rescue the one step that failed, and it made the engagement cost
-    # 49 s against 33 s
+    # (``ehl.continuation._pseudo_march``): on an engagement (257 nodes, 3500 rpm) it did not
+    # rescue the step that failed, and it made the engagement cost 49 s against 33 s
     model = dataclasses.replace(model, pseudo_transient_steps=0)
     sols, worn = _passage(
         model,
