@@ -71,7 +71,7 @@ def _system(n, kind):
             + surf.displaced_height(1, x, displacement[1])
         )
         numbers, static = _split_numbers(model)
-        inp = _Inputs(contact, LUB, rho_h, inv_dt, offset, zero, zero, surf.composite_rq, numbers)
+        inp = _Inputs(contact, LUB, rho_h, inv_dt, offset, zero, surf.composite_rq, numbers)
         return _fine_level(static, dataclasses.replace(inp, rough=True))[1]
 
     steady, step = level(jnp.zeros(2), None), level(moved, first)

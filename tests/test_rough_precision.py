@@ -26,13 +26,13 @@ def test_only_rough_films_take_the_single_precision_lu_at_257_nodes():
     c = gear_contact(rpm=3500.0)
     x = _grid_positions(model, c, LUB)
     z = np.zeros(x.shape)
-    inp = _Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()), numbers)
+    inp = _Inputs(c, LUB, z, np.zeros(()), z, z, np.zeros(()), numbers)
     assert not newton._mixed_precision(_fine_level(model, inp)[1])
     rough = dataclasses.replace(inp, rough=True)
     assert newton._mixed_precision(_fine_level(model, rough)[1])
     numbers, coarse = _split_numbers(jg.EHLModel(n_nodes=129))
     z = np.zeros(129)
-    small = _Inputs(c, LUB, z, np.zeros(()), z, z, z, np.zeros(()), numbers, rough=True)
+    small = _Inputs(c, LUB, z, np.zeros(()), z, z, np.zeros(()), numbers, rough=True)
     assert not newton._mixed_precision(_fine_level(coarse, small)[1])
 
 

@@ -27,7 +27,7 @@ def _fine_level(n=65, transient=True):
     z = jnp.zeros(n)
     numbers, model = _split_numbers(jg.EHLModel(n_nodes=n, mixed="deterministic"))
     offset = 1e-7 * jnp.sin(x / 1e-5)
-    inp = _Inputs(c, LUB, rho_h_prev, inv_dt, offset, z, z, jnp.zeros(()), numbers)
+    inp = _Inputs(c, LUB, rho_h_prev, inv_dt, offset, z, jnp.zeros(()), numbers)
     return discretisation._fine_level(model, inp)[1]
 
 

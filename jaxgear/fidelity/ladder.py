@@ -148,16 +148,18 @@ class ContactModel(eqx.Module):
 
     Attributes:
         friction: "constant", "regression", "ehl_formula", "ehl_smooth" or "ehl_mixed".
-            "ehl_formula" is the statistical mixed EHL contact in closed form (Pan-Hamrock film,
-            Greenwood-Tripp asperity load, Eyring fluid traction over the Hertz zone,
+            "ehl_formula" is the statistical mixed EHL contact in closed form (Pan-Hamrock film
+            read as the average gap, Greenwood-Tripp asperity load at the mean-plane separation,
+            Eyring fluid traction over the Hertz zone's non-contact share,
             Goksem-Hargreaves rolling traction: ``lubrication/ehl_formula.py``); it uses
             ``shear``, μb and the asperity constants like the EHL rungs, and is iso-thermal and
             quasi-steady (``thermal`` and ``transient`` act on the EHL rungs only).
         thermal: thermal EHL (film and surface temperatures) instead of iso-thermal.
         transient: transient EHL marching through the engagement instead of quasi-steady
             contacts.
-        mixed_model: roughness treatment of the "ehl_mixed" rung: "statistical" (Greenwood-Tripp
-            asperity pressure with the mean film: robust in deep mixed lubrication) or
+        mixed_model: roughness treatment of the "ehl_mixed" rung: "statistical" (the film on the
+            surfaces' mean planes: average gap, Patir-Cheng flow factor, Greenwood-Tripp asperity
+            pressure; from full film to boundary lubrication) or
             "deterministic" (the roughness profiles in the film, unified Reynolds; it needs
             n_nodes ≳ 513 and does not converge in deep mixed lubrication).
         shear: fluid shear law (``EHLModel.shear``): "eyring_paper" (the paper's η* =
@@ -500,14 +502,13 @@ class Fidelity(eqx.Module):
     @property
     def fixed_point_rtol(self) -> float:
         """The fixed-point tolerance in use: ``fixed_point_tolerance``, or by default 1e-4, and
-        3e-3 where the contacts carry an outer iteration (thermal or statistical-asperity Picard
-        loops, which stop once the film temperature moves by < 1 % of its rise and the asperity
-        pressure by < 1e-3 ph, so the friction tables are reproducible only to about 1e-3 of
-        their maximum; with 1e-4 the Anderson iteration flip-flops between two tables ~1e-3
-        apart until its cap)."""
+        3e-3 where the contacts carry an outer iteration (the thermal Picard loop, which stops
+        once the film temperature moves by < 1 % of its rise, so the friction tables are
+        reproducible only to about 1e-3 of their maximum; with 1e-4 the Anderson iteration
+        flip-flops between two tables ~1e-3 apart until its cap)."""
         if self.coupled.fixed_point_tolerance is not None:
             return self.coupled.fixed_point_tolerance
-        picard = self.uses_ehl and (self.contact.thermal or self.contact.friction == "ehl_mixed")
+        picard = self.uses_ehl and self.contact.thermal
         # frozen coupling: the contacts are solved once, outside the iteration (no Picard noise)
         return 3e-3 if picard and self.coupled.coupling == "fixed_point" else 1e-4
 

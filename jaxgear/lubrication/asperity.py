@@ -9,14 +9,30 @@ Johnson, Greenwood & Poon 1972):
 and the real-contact area ratio A_r/A = π² (nβσ)² F_2(h/σ), with n the summit density, β the summit
 radius and F_n(λ) = (2π)^(−½) ∫_λ^∞ (s − λ)^n e^(−s²/2) ds. F_n is evaluated by Gauss-Legendre
 quadrature (no curve fit), so it is smooth and differentiable in λ for any sign of λ.
+
+Both are evaluated at the separation d of the surfaces' mean planes, which goes negative where the
+asperities carry most of the load. The film that carries the flow is the average gap (the expected
+gap between a flat and a Gaussian composite surface of standard deviation σ),
+
+    h_T(d) = σ [λ Φ(λ) + φ(λ)],   λ = d/σ,   dh_T/dd = Φ(λ),
+
+(Φ, φ the standard normal distribution and density; h_T = σ F_1(−λ)), and its Poiseuille flow
+carries Patir & Cheng's (1978) pressure flow factor for isotropic roughness (γ = 1),
+φx = 1 − 0.90 exp(−0.56 λ). Patir and Cheng fitted it for λ ≥ 0.5; below, λ is replaced by a
+smooth positive floor of width 0.1 (``smooth_positive``), so φx falls smoothly to 0.1 at λ → −∞,
+where the average gap has closed anyway.
 """
 
 from __future__ import annotations
 
 import math
 
+import jax
 import jax.numpy as jnp
 import numpy as np
+from jax.scipy.special import erfc
+
+from .reynolds import smooth_positive
 
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(160)
 
@@ -45,3 +61,63 @@ def asperity_pressure(h, sigma, e_reduced, density_product, slope_ratio):
 def contact_area_ratio(h, sigma, density_product):
     """A_r/A = π² (nβσ)² F_2(h/σ)."""
     return jnp.minimum(math.pi**2 * density_product**2 * gt_integral(2.0, h / sigma), 1.0)
+
+
+def normal_cdf(lam):
+    """Φ(λ), the standard normal distribution function (by erfc: accurate in both tails)."""
+    return 0.5 * erfc(-lam / math.sqrt(2.0))
+
+
+def normal_pdf(lam):
+    """φ(λ), the standard normal density."""
+    return jnp.exp(-0.5 * lam * lam) / math.sqrt(2.0 * math.pi)
+
+
+def average_gap(d, sigma):
+    """h_T(d) = σ [λΦ(λ) + φ(λ)], λ = d/σ: the average gap, m, at the mean-plane separation d
+    (m, any sign) of surfaces of composite roughness σ (m, > 0). h_T(0) = σ/√(2π); h_T → d for
+    d ≫ σ (relative difference ≈ φ(λ)/λ³); h_T → 0 for d ≪ −σ."""
+    lam = d / sigma
+    return sigma * (lam * normal_cdf(lam) + normal_pdf(lam))
+
+
+_INVERSE_ITERATIONS = 40
+
+
+def separation_of_gap(h, sigma):
+    """The mean-plane separation d, m, whose average gap ``average_gap(d, σ)`` is h (m, > 0).
+
+    Newton on ln h_T(λ) (concave in λ: after the first step the iterates rise to the root
+    monotonically), then one last step outside the stopped iterations, so that derivatives are
+    those of the implicit function (dd/dh = 1/Φ(λ))."""
+    g = h / sigma
+    log_g = jnp.log(g)
+
+    def f(lam):
+        return jnp.log(lam * normal_cdf(lam) + normal_pdf(lam)) - log_g
+
+    def slope(lam):
+        return normal_cdf(lam) / (lam * normal_cdf(lam) + normal_pdf(lam))
+
+    # start: the film itself where it is thick; the Gaussian tail's λ where it is thin
+    thin = -jnp.sqrt(2.0 * jnp.maximum(-jnp.log(jnp.minimum(g, 0.3) * math.sqrt(2.0 * math.pi)), 0.0))
+    lam = jax.lax.stop_gradient(jnp.where(g > 0.4, g, thin))
+
+    def step(_, lam):
+        return lam - f(lam) / slope(lam)
+
+    lam = jax.lax.stop_gradient(jax.lax.fori_loop(0, _INVERSE_ITERATIONS, step, lam))
+    return sigma * (lam - f(lam) / slope(lam))
+
+
+#: Patir & Cheng (1978) pressure flow factor of isotropic roughness (γ = 1): φx = 1 − C e^(−r λ).
+PATIR_CHENG_PRESSURE = (0.90, 0.56)
+_FLOW_FACTOR_FLOOR = 0.1  # width of the smooth floor on λ below Patir and Cheng's fitted range
+
+
+def pressure_flow_factor(d, sigma):
+    """φx(λ) = 1 − 0.90 exp(−0.56 λ⁺), λ = d/σ, λ⁺ a smooth positive floor of λ (width 0.1):
+    Patir & Cheng's pressure flow factor of isotropic roughness, in (0.1, 1]."""
+    c, r = PATIR_CHENG_PRESSURE
+    lam = smooth_positive(d / sigma, _FLOW_FACTOR_FLOOR)
+    return 1.0 - c * jnp.exp(-r * lam)

@@ -261,10 +261,6 @@ def _step(model, numbers, mixed, lubricant, surfaces, solids, depth, carry, cont
         start = _temperature_start(mixed, prev, x, inlet, contact.rolling_velocity * dt)
         start = jnp.where(prev_ok, start, 0.0)
     sigma = jnp.zeros(()) if surfaces is None else surfaces.composite_rq
-    if first:
-        seed = jnp.zeros_like(x)
-    else:
-        seed = jnp.where(prev_ok, jnp.interp(x, prev.x, prev.asperity_pressure), 0.0)
     inp = _Inputs(
         contact,
         lubricant,
@@ -274,11 +270,11 @@ def _step(model, numbers, mixed, lubricant, surfaces, solids, depth, carry, cont
         # the temperature iteration starts here (the film's ∂ϕm/∂t term reads ``rise``: the
         # previous temperature where it stood)
         rise if first else start,
-        seed,
         sigma,
         numbers,
         # where the roughness stood at the previous step: a deterministic step's start generator
         _roughness_offset(mixed, surfaces, x, d_prev) if mixed == "deterministic" else None,
+        mean_plane=mixed == "statistical",
     )
     transient = None
     # how far each surface's material moved in this step: by the trapezoidal rule under BDF2
@@ -391,7 +387,15 @@ def _passage(model, mixed, contacts, lubricant, surfaces, times, displacement0, 
             False,
             mixed,
             _Inputs(
-                first_contact, lubricant, x0, jnp.zeros(()), x0, x0, x0, jnp.zeros(()), numbers
+                first_contact,
+                lubricant,
+                x0,
+                jnp.zeros(()),
+                x0,
+                x0,
+                jnp.zeros(()),
+                numbers,
+                mean_plane=mixed == "statistical",
             ),
             x0[:2],
             x0[:2],

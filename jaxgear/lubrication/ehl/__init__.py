@@ -29,7 +29,7 @@ Modules, each importing only those above it:
 - ``starts``: cold and warm starts, relaxation sweeps; ``continuation``: the continuations on the
   finest grid (exponent, roughness, temperatures, pseudo-time).
 - ``core``: the differentiable solve (``_solve_core``, implicit derivative) and its SI outputs.
-- ``outer``: the thermal and asperity-pressure iterations around it (``_solve_impl``).
+- ``outer``: the thermal iteration around it (``_solve_impl``).
 - ``solve``: ``solve_ehl``.
 """
 

@@ -271,16 +271,21 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     r = c.reduced_radius
     h_scale = sc.b**2 / r
     p_nd, delta = lev.plastic(u[:n])
-    p_dim = sc.ph * p_nd
     big_h = lev.film(u)
+    # the statistical film: p_nd the total pressure, big_h the mean-plane separation; the fluid
+    # carries its own pressure through the average gap (``_Level.fluid``, ``_Level.gap``)
+    p_asp = sc.ph * lev.asperity(big_h)
+    p_dim = sc.ph * lev.fluid(p_nd, big_h)  # the fluid's pressure
     h = big_h * h_scale
+    gap = lev.gap(big_h) * h_scale
+    factor = lev.flow_factor(big_h)
     x = lev.x * sc.b
     dx = lev.spacing * sc.b
     t = lev.temperature
     rho = lub.density_at(p_dim, t, model.compressibility == "dowson_higginson")
     log_eta = lub.log_viscosity(p_dim, t, model.viscosity)
     eta = jnp.exp(log_eta)
-    h_eff = smooth_positive(h, _FLOOR_FRACTION * sc.h_ref * h_scale)
+    h_eff = smooth_positive(gap, _FLOOR_FRACTION * sc.h_ref * h_scale)
     abs_us = jnp.sqrt(sc.us**2 + (1e-6 * sc.um) ** 2)
     log_s = log_eta + jnp.log(abs_us / (lub.eyring_stress * h_eff))
     log_eta_s = log_eta + _log_shear_factor(model, log_s, "stress")  # secant: τ h/|us|
@@ -293,34 +298,40 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     eta_s = jnp.exp(log_eta_s)
     eta_t = jnp.exp(log_eta + _log_shear_factor(model, log_s, "flow"))  # flow coefficient, damping
     # asperity contact (paper Eq. 4b/4c, 12, 15): boundary friction μb p on closed nodes
+    # (deterministic), μb p_a on the real contact area (statistical)
     if mixed == "deterministic":
         contact = _contact_indicator(model, sc, big_h)
+    elif inp.mean_plane:
+        contact = asperity_mod.contact_area_ratio(
+            h, jnp.maximum(inp.roughness, 1e-12), inp.numbers.asperity_density_product
+        )
     else:
         contact = jnp.zeros_like(big_h)
-    p_asp = inp.asperity_pressure  # statistical asperity pressure (zero otherwise)
     fluid = 1.0 - contact
+    # the load on the asperities: the closed nodes' pressure (deterministic), p_a (statistical)
+    p_solid = p_asp if inp.mean_plane else contact * p_dim
     dpdx = jnp.gradient(p_dim, dx)
     # Fill fraction of the cavitated outlet: the mass flux through x = 0 carried as Couette streaks.
     rho_h = rho * h_eff
-    eps_flux = rho * h_eff**3 / (12.0 * eta_t) * dpdx
+    eps_flux = factor * rho * h_eff**3 / (12.0 * eta_t) * dpdx
     q = jnp.interp(0.0, x, rho_h * sc.um - eps_flux)
     fill = jnp.where(x > 0.0, jnp.clip(q / (sc.um * rho_h), 0.0, 1.0), 1.0)
     weights = jnp.full((n,), dx).at[0].set(0.5 * dx).at[-1].set(0.5 * dx)
     q_slide = fluid * fill * eta_s * sc.us**2 / h_eff  # paper Eq. (12), sliding part
-    q_asp = (
-        inp.numbers.boundary_friction * (contact * p_dim + p_asp) * abs_us
-    )  # paper Eq. (12), h = 0
+    q_asp = inp.numbers.boundary_friction * p_solid * abs_us  # paper Eq. (12), h = 0
     # Poiseuille terms on cell faces, as the Reynolds discretisation has them (flow coefficient
     # averaged to the face, pressure gradient by the face difference)
-    flow = fluid * h_eff**3 / (12.0 * eta_t)
+    flow = (1.0 - contact if mixed == "deterministic" else factor) * h_eff**3 / (12.0 * eta_t)
     dp_face = jnp.diff(p_dim) / dx
     q_roll_face = 0.5 * (flow[1:] + flow[:-1]) * dp_face**2  # paper Eq. (12), rolling part
     q_roll = 0.5 * (jnp.pad(q_roll_face, (1, 0)) + jnp.pad(q_roll_face, (0, 1)))
     sign = (c.u2 - c.u1) / abs_us
     # paper Eq. (15): Fs = Σ μb p (asperity) + Σ η*(u2 − u1)/h (fluid); Fr = Σ (h/2) ∂p/∂x (fluid)
     fs_fluid = jnp.sum(weights * fluid * fill * eta_s * (c.u2 - c.u1) / h_eff)
-    fs_asp = jnp.sum(weights * inp.numbers.boundary_friction * (contact * p_dim + p_asp)) * sign
-    h_face = 0.5 * (h[1:] + h[:-1]) * 0.5 * (fluid[1:] + fluid[:-1])
+    fs_asp = jnp.sum(weights * inp.numbers.boundary_friction * p_solid) * sign
+    film_gap = gap if inp.mean_plane else h
+    open_face = 1.0 if inp.mean_plane else 0.5 * (fluid[1:] + fluid[:-1])
+    h_face = 0.5 * (film_gap[1:] + film_gap[:-1]) * open_face
     fr = jnp.sum(0.5 * h_face * jnp.diff(p_dim))
     cm = jnp.sum(weights * fluid * fill * eta_t / h_eff)  # paper Eq. (13) per unit width
     # sub-grid minimum film by a parabola through the smallest node and its neighbours
@@ -338,19 +349,12 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
     p_loss_asp = jnp.sum(weights * q_asp)
     p_loss_roll = jnp.sum(q_roll_face) * dx
     t_in = jnp.broadcast_to(c.inlet_temperature, t.shape)
-    if mixed == "statistical":
-        area = asperity_mod.contact_area_ratio(
-            jnp.maximum(h, 0.0) + jnp.minimum(h, 0.0),
-            inp.roughness,
-            inp.numbers.asperity_density_product,
-        )
-        fraction = jnp.sum(hertz_zone * area) / jnp.sum(hertz_zone)
-    else:
-        fraction = jnp.sum(hertz_zone * contact) / jnp.sum(hertz_zone)
+    fraction = jnp.sum(hertz_zone * contact) / jnp.sum(hertz_zone)
     return EHLSolution(
         x=x,
         p=p_dim + p_asp,
         h=h,
+        gap=gap,
         density=rho,
         viscosity=eta,
         shear_viscosity=eta_s,
@@ -377,7 +381,7 @@ def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> E
         power_loss_rolling=p_loss_roll,
         power_loss_asperity=p_loss_asp,
         contact_fraction=fraction,
-        contact_load=jnp.sum(weights * (contact * p_dim + p_asp)),
+        contact_load=jnp.sum(weights * p_solid),
         plastic_gap=jnp.zeros_like(h) if delta is None else delta * h_scale,
         load_error=load_err,
         hertz_half_width=sc.b,

@@ -10,6 +10,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array
 
+from .. import asperity as asperity_mod
 from .. import deformation as deformation_mod
 from .. import rheology
 from ..lubricant import Lubricant
@@ -222,7 +223,6 @@ class _Level(eqx.Module):
     # 1, or 0 in a transient step whose squeeze term is the material derivative along the
     # characteristics (``EHLModel.transport``), which carries the wedge term
     wedge_weight: Array
-    asperity: Array  # dimensionless asperity pressure (held fixed within a Newton solve)
 
     def with_roughness(self, factor):
         """The same system with the film offset (roughness) scaled by ``factor``."""
@@ -248,8 +248,45 @@ class _Level(eqx.Module):
         return self.rho_nodes
 
     def rho_h(self, u):
-        """ρ̄H at the nodes for the state u (what the squeeze term of the next step reads)."""
-        return self.density(self.plastic(u[: self.n])[0]) * self.film(u)
+        """ρ̄H at the nodes for the state u (what the squeeze term of the next step reads); H the
+        film that carries the flow (``gap``)."""
+        p, h = self.plastic(u[: self.n])[0], self.film(u)
+        return self.density(self.fluid(p, h)) * self.gap(h)
+
+    def _roughness(self):
+        """The dimensionless composite roughness σ R/b² (floored: a statistical film of zero
+        roughness is the smooth film)."""
+        h_scale = self.sc.b**2 / self.inp.contact.reduced_radius
+        return jnp.maximum(self.inp.roughness, 1e-12) / h_scale
+
+    def asperity(self, h):
+        """The dimensionless Greenwood-Tripp asperity pressure p_a/ph at the film H (the
+        mean-plane separation) of a statistical film; zero for the others."""
+        if not self.inp.mean_plane:
+            return jnp.zeros_like(h)
+        sigma = self._roughness()
+        k = asperity_mod.asperity_constant(
+            self.inp.numbers.asperity_density_product, self.inp.numbers.asperity_slope_ratio
+        )
+        e_over_ph = self.inp.contact.e_reduced / self.sc.ph
+        return k * e_over_ph * asperity_mod.gt_integral(2.5, h / sigma)
+
+    def fluid(self, p, h):
+        """The fluid's pressure P − p_a(H) (P the total pressure unknown)."""
+        return p - self.asperity(h) if self.inp.mean_plane else p
+
+    def gap(self, h):
+        """The film that carries the flow: the average gap h_T(H) of a statistical film, H of the
+        others."""
+        if not self.inp.mean_plane:
+            return h
+        return asperity_mod.average_gap(h, self._roughness())
+
+    def flow_factor(self, h):
+        """Patir and Cheng's pressure flow factor φx(H) of a statistical film; 1 for the others."""
+        if not self.inp.mean_plane:
+            return jnp.ones_like(h)
+        return asperity_mod.pressure_flow_factor(h, self._roughness())
 
     def plastic(self, v):
         """(P, δ) of the pressure unknowns v: the pressure and the dimensionless plastic gap.
@@ -270,7 +307,7 @@ class _Level(eqx.Module):
         """The film without H0 and the rigid gap: deformation, offset (roughness) and plastic gap
         for the pressure unknowns v."""
         p, delta = self.plastic(v)
-        h = self.deformation(p + self.asperity) + self.offset
+        h = self.deformation(p) + self.offset
         return h if delta is None else h + delta
 
     def deformation(self, p):
@@ -282,19 +319,24 @@ class _Level(eqx.Module):
 
     def film(self, u):
         p, delta = self.plastic(u[: self.n])
-        h = u[self.n] + 0.5 * self.x**2 + self.offset + self.deformation(p + self.asperity)
+        h = u[self.n] + 0.5 * self.x**2 + self.offset + self.deformation(p)
         return h if delta is None else h + delta
 
     def local(self, p, h, s):
-        """Node-wise FB residual as a function of P and H (banded dependence, bandwidth −2…+1)."""
+        """Node-wise FB residual as a function of P and H (banded dependence, bandwidth −2…+1):
+        the complementarity of the fluid's pressure and the Reynolds residual."""
         r, diag = self.reynolds(p, h, s)
-        f = fischer_burmeister(p, -r / (1.0 + diag), self.model.smoothing(self.inp.rough))
-        return f.at[0].set(p[0]).at[-1].set(p[-1])
+        pf = self.fluid(p, h)
+        f = fischer_burmeister(pf, -r / (1.0 + diag), self.model.smoothing(self.inp.rough))
+        return f.at[0].set(pf[0]).at[-1].set(pf[-1])
 
     def reynolds(self, p, h, s):
         """The discrete Reynolds residual R and its Poiseuille diagonal D (``reynolds_residual``) as
-        functions of P and H."""
+        functions of P and H (of a statistical film: the total pressure and the mean-plane
+        separation; the flow then carries the fluid's pressure and the average gap)."""
         m, sc = self.model, self.sc
+        factor = self.flow_factor(h)
+        p, h = self.fluid(p, h), self.gap(h)
         pressure = sc.ph * p
         log_eta = self.log_eta0_nodes - sc.log_eta0
         if m.viscosity == "barus":
@@ -312,7 +354,7 @@ class _Level(eqx.Module):
         else:
             log_s = sc.log_kappa + log_eta - jnp.log(h_eff)
             log_eta_s = log_eta + _log_shear_factor(m, log_s)
-        log_eps = jnp.log(rho * h_eff**3) - log_eta_s - sc.log_lambda
+        log_eps = jnp.log(factor * rho * h_eff**3) - log_eta_s - sc.log_lambda
         return reynolds_residual(
             p,
             rho * h,
@@ -325,7 +367,7 @@ class _Level(eqx.Module):
         )
 
     def load_row(self, p):
-        return (self.spacing * jnp.sum(p + self.asperity) - 0.5 * jnp.pi) / (0.5 * jnp.pi)
+        return (self.spacing * jnp.sum(p) - 0.5 * jnp.pi) / (0.5 * jnp.pi)
 
     def residual(self, u, s=1.0):
         p = self.plastic(u[: self.n])[0]
@@ -419,13 +461,11 @@ def _make_level(model: EHLModel, inp: _Inputs, sc: _Scales, n: int, fine_n: int)
         offset = inp.film_offset / h_scale
         prev = inp.rho_h_previous / (sc.rho0 * h_scale)
         rise = inp.temperature_rise
-        asperity = inp.asperity_pressure / sc.ph
     else:
         x_fine, _ = _grid(sc, fine_n)
         offset = jnp.interp(x, x_fine, inp.film_offset) / h_scale
         prev = jnp.interp(x, x_fine, inp.rho_h_previous) / (sc.rho0 * h_scale)
         rise = jnp.interp(x, x_fine, inp.temperature_rise)
-        asperity = jnp.interp(x, x_fine, inp.asperity_pressure) / sc.ph
     t = inp.contact.inlet_temperature + rise
     lub = inp.lubricant
     log_eta0 = lub.log_base_viscosity(t)
@@ -450,7 +490,6 @@ def _make_level(model: EHLModel, inp: _Inputs, sc: _Scales, n: int, fine_n: int)
         offset,
         prev,
         wedge_weight,
-        asperity,
     )
 
 
@@ -474,7 +513,7 @@ def _grid_positions(model: EHLModel, contact: LineContact, lubricant: Lubricant)
         _, model = _split_numbers(model)
     zero = jnp.zeros(())
     numbers = _Numbers(zero, zero, zero, zero)  # the grid does not depend on them
-    inp = _Inputs(contact, lubricant, z, zero, z, z, z, zero, numbers)
+    inp = _Inputs(contact, lubricant, z, zero, z, z, zero, numbers)
     sc = _scales(model, inp)
     x, _ = _grid(sc, n)
     return x * sc.b

@@ -196,13 +196,18 @@ class EHLModel(eqx.Module):
             reached by the pseudo-time march (``pseudo_transient_steps``). A continuation that
             accepted at least one step and then failed is not repeated by a second cold attempt
             (it would start from the same smooth film and take the same path).
-            "statistical": the mean film with the Greenwood-Tripp asperity pressure p_a(h)
-            (``asperity.py``) added to the load and the deformation (Johnson-Greenwood-Poon load
-            sharing), iterated with the temperatures; robust down to λ → 0; it needs only the
-            composite roughness σ.
+            "statistical": the film on the surfaces' mean planes (``asperity.py``): the film
+            unknown is the mean-plane separation d = h0 + x²/2R + V(p), which may be negative;
+            the flow carries the average gap h_T(d) with Patir and Cheng's pressure flow factor
+            (the shear flow factor, ∝ Rq1² − Rq2², is left out: zero for surfaces of equal
+            roughness); the Greenwood-Tripp asperity pressure p_a(d) = K′E′F_{5/2}(d/σ) is part
+            of the pressure that loads and deforms the solids, solved in the same Newton system
+            as the fluid's (its unknown is the total pressure); the fluid shears over the
+            non-contact fraction 1 − A_r/A at the average gap, the asperities carry μb p_a. It
+            spans full film (λ ≳ 3: the smooth film) to boundary lubrication (λ → 0: the dry
+            rough contact) and needs only the composite roughness σ.
         asperity_density_product, asperity_slope_ratio: nβσ and σ/β of the statistical model
             [typical values for ground steel: 0.05, 0.01].
-        asperity_relaxation: under-relaxation of the asperity-pressure update (statistical).
         limiting_shear_coefficient: Λ of a limiting shear stress τL = Λ p (Bair & Winer) capping,
             smoothly, the fluid shear stress of the friction and the sliding heat at the local
             fluid pressure (``rheology.log_limited_stress``), in (0, 1]; None (default): no cap.
@@ -291,8 +296,8 @@ class EHLModel(eqx.Module):
             ground surfaces at 500 rpm on 1025 nodes). A passage
             (``passage.solve_ehl_passage``) runs the surfaces in: what a step flattens stays in
             both profiles (half each) and travels with each surface, so a later step's δ is only
-            what more yields. The statistical asperity pressure (``mixed="statistical"``) is
-            outside it.
+            what more yields. On the statistical film (``mixed="statistical"``) it caps the
+            total (fluid plus asperity) pressure.
     """
 
     n_nodes: int = eqx.field(static=True, default=257)
@@ -320,7 +325,6 @@ class EHLModel(eqx.Module):
     mixed: str = eqx.field(static=True, default="deterministic")
     asperity_density_product: Float[Array, ""] = eqx.field(converter=_float64, default=0.05)
     asperity_slope_ratio: Float[Array, ""] = eqx.field(converter=_float64, default=0.01)
-    asperity_relaxation: float = eqx.field(static=True, default=0.5)
     limiting_shear_coefficient: Float[Array, ""] | None = eqx.field(
         converter=_float64_or_none, default=None
     )
@@ -353,7 +357,6 @@ class EHLModel(eqx.Module):
         check_choice("EHLModel.transport", self.transport, TRANSPORT_SCHEMES)
         check_range("EHLModel.asperity_density_product", self.asperity_density_product, 1e-4, 1.0)
         check_range("EHLModel.asperity_slope_ratio", self.asperity_slope_ratio, 1e-6, 1.0)
-        check_range("EHLModel.asperity_relaxation", self.asperity_relaxation, 0.01, 1.0)
         if self.limiting_shear_coefficient is not None:
             check_range(
                 "EHLModel.limiting_shear_coefficient",
@@ -463,7 +466,6 @@ class _Inputs(eqx.Module):
     inv_time_step: Float[Array, ""]  # 1/Δt, 1/s (0: steady)
     film_offset: Float[Array, " N"]  # m, added to h: −(S1 + S2), the roughness of paper Eq. (5)
     temperature_rise: Float[Array, " N"]  # K, mean film temperature above the inlet, at the nodes
-    asperity_pressure: Float[Array, " N"]  # Pa, statistical asperity pressure at the nodes
     roughness: Float[Array, ""]  # m, composite roughness σ (statistical mixed model)
     numbers: _Numbers  # the model's physical constants (``MODEL_NUMBERS``), traced
     # m, the film offset with the roughness where it stood at the previous time step (transient
@@ -475,3 +477,7 @@ class _Inputs(eqx.Module):
     # a deterministic rough film's solve (set by ``_solve_core``: the Newton matrix's LU is single
     # precision on coarser grids, see ``_MIXED_PRECISION_NODES_ROUGH``)
     rough: bool = eqx.field(static=True, default=False)
+    # the statistical mixed film (``EHLModel.mixed = "statistical"`` on rough surfaces): the film
+    # unknown is the mean-plane separation, the flow carries its average gap, and the pressure
+    # unknown is the total (fluid plus Greenwood-Tripp asperity) pressure
+    mean_plane: bool = eqx.field(static=True, default=False)

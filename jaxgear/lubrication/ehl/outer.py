@@ -1,6 +1,6 @@
 """The outer iterations of a solve (``_solve_impl``): the film's temperatures from its heat
-(Picard, the update relaxed by Aitken's rule) and the statistical asperity pressure from its
-film, each re-solve warm-started, until they agree with those the film was solved with."""
+(Picard, the update relaxed by Aitken's rule), each re-solve warm-started, until they agree with
+those the film was solved with."""
 
 from __future__ import annotations
 
@@ -10,7 +10,6 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from .. import asperity as asperity_mod
 from .. import thermal as thermal_mod
 from .core import _postprocess, _solve_core
 from .model import EHLModel, _Inputs
@@ -29,7 +28,7 @@ def _temperatures(inp: _Inputs, sol: EHLSolution, solids, transient=None):
     return thermal_mod.solve_contact_temperatures(
         sol.x,
         sol.heat_flux,
-        jnp.maximum(sol.h, 0.0),
+        jnp.maximum(sol.gap, 0.0),
         c.u1,
         c.u2,
         solids[0],
@@ -59,33 +58,19 @@ def _with_temperatures(sol: EHLSolution, temps, inlet, thermal_residual) -> EHLS
 
 
 def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transient=None):
-    """One solve (steady or one transient step); thermal when ``model.thermal``; with the
-    statistical asperity pressure when ``mixed == "statistical"``.
+    """One solve (steady or one transient step); thermal when ``model.thermal``.
 
     Returns (solution, temperatures or None)."""
     u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0)
     sol = _postprocess(model, mixed, inp, u, res, it, ok)
-    statistical = mixed == "statistical"
-    if not (model.thermal or statistical):
+    if not model.thermal:
         return sol, None
-    n_outer = _thermal_iterations(model, mixed) if model.thermal else 0
-    if statistical:
-        n_outer = max(n_outer, _ASPERITY_ITERATIONS)
-    ph = sol.hertz_pressure
+    n_outer = _thermal_iterations(model, mixed)
     max_step = _DETERMINISTIC_TEMPERATURE_STEP if mixed == "deterministic" else None
     # a deterministic film's re-solves know the temperatures their start was solved at
     hot = model.thermal and mixed == "deterministic" and model.temperature_steps > 0
     if hot:
         inp = dataclasses.replace(inp, temperature_rise_previous=inp.temperature_rise)
-
-    def asperity_of(sol, inp_k):
-        return asperity_mod.asperity_pressure(
-            sol.h,
-            inp_k.roughness,
-            inp_k.contact.e_reduced,
-            inp_k.numbers.asperity_density_product,
-            inp_k.numbers.asperity_slope_ratio,
-        )
 
     def thermal_settled(change, rise):
         # the film temperature moved by < thermal_rtol of its largest rise (or < thermal_atol K)
@@ -94,32 +79,22 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
         )
 
     def updates(sol, inp_k, solids, transient, relax):
-        """The inputs the solution ``sol`` implies (temperatures, relaxed; relaxed asperity
-        pressure), whether they agree with those it was solved with (then the outer iteration has
-        converged), and the temperature relaxation's new state (``_aitken``)."""
-        inp_next, settled = inp_k, jnp.asarray(True)
-        if model.thermal:
-            temps = _temperatures(inp_k, sol, solids, transient)
-            rise = _safe_rise(temps.film_mean)
-            change = jnp.max(jnp.abs(rise - inp_k.temperature_rise))
-            settled = settled & thermal_settled(change, rise)
-            relaxed, relax = _aitken(inp_k.temperature_rise, rise, relax, max_step)
-            inp_next = eqx.tree_at(lambda i: i.temperature_rise, inp_next, relaxed)
-            if hot:
-                previous = inp_k.temperature_rise
-                inp_next = eqx.tree_at(lambda i: i.temperature_rise_previous, inp_next, previous)
-        if statistical:
-            ph = sol.hertz_pressure
-            beta = model.asperity_relaxation
-            target = jnp.where(jnp.isfinite(sol.h), asperity_of(sol, inp_k), 0.0)
-            target = jnp.minimum(target, 20.0 * ph)
-            settled = settled & (jnp.max(jnp.abs(target - inp_k.asperity_pressure)) <= 1e-3 * ph)
-            pa = (1.0 - beta) * inp_k.asperity_pressure + beta * target
-            inp_next = eqx.tree_at(lambda i: i.asperity_pressure, inp_next, pa)
+        """The inputs the solution ``sol`` implies (its temperatures, relaxed), whether they
+        agree with those it was solved with (then the outer iteration has converged), and the
+        temperature relaxation's new state (``_aitken``)."""
+        temps = _temperatures(inp_k, sol, solids, transient)
+        rise = _safe_rise(temps.film_mean)
+        change = jnp.max(jnp.abs(rise - inp_k.temperature_rise))
+        settled = thermal_settled(change, rise)
+        relaxed, relax = _aitken(inp_k.temperature_rise, rise, relax, max_step)
+        inp_next = eqx.tree_at(lambda i: i.temperature_rise, inp_k, relaxed)
+        if hot:
+            previous = inp_k.temperature_rise
+            inp_next = eqx.tree_at(lambda i: i.temperature_rise_previous, inp_next, previous)
         return inp_next, settled, relax
 
-    # Outer (Picard) iteration: Reynolds at fixed temperatures and asperity pressures (Newton, warm
-    # started), then the temperatures of its heat source and the asperity pressure of its film. It
+    # Outer (Picard) iteration: Reynolds at fixed temperatures (Newton, warm started), then the
+    # temperatures of its heat source. It
     # stops once they agree with those the film was solved with (the remaining steps are skipped by
     # lax.cond: no work when solved one contact at a time; a scan, not a while loop, so that
     # reverse-mode differentiation works). Under vmap the skipped steps still run; the vmap-lazy
@@ -172,13 +147,6 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
     zero = jnp.zeros_like(inp.temperature_rise)
     init = (sol, inp, jnp.asarray(False), (jnp.ones((), zero.dtype), zero, jnp.asarray(False)))
     (sol, inp_last, _, _), _ = jax.lax.scan(picard, init, None, length=n_outer)
-    if statistical:
-        # the asperity pressure of the final film agrees with the one the film was solved with
-        pa_gap = jnp.max(jnp.abs(asperity_of(sol, inp_last) - inp_last.asperity_pressure))
-        pa_ok = pa_gap <= 1e-3 * ph
-        sol = eqx.tree_at(lambda s: s.converged, sol, sol.converged & pa_ok)
-    if not model.thermal:
-        return sol, None
     temps = _finite_temperatures(_temperatures(inp_last, sol, solids, transient))
     change = jnp.max(jnp.abs(temps.film_mean - inp_last.temperature_rise))
     change = jnp.where(jnp.isfinite(change), change, jnp.finfo(change.dtype).max)
@@ -242,7 +210,6 @@ def _aitken(x, g, state, max_step=None):
     return x + omega * r, (omega, r, jnp.asarray(True))
 
 
-_ASPERITY_ITERATIONS = 12  # outer iterations of the statistical asperity pressure (β = ½: 2^-12)
 # K: a temperature rise outside [_MIN_RISE, _MAX_RISE] only comes from a failed solve (converged
 # films: ≤ 440 K above the inlet at their hottest node, the 1025-node thermal deterministic film; the
 # heat only flows into the film, so a rise below 0 is numerical undershoot). The bounds keep the

@@ -16,7 +16,11 @@ class EHLSolution(eqx.Module):
 
     Attributes:
         x: node positions, m, (N,) (x = 0 at the Hertz centre, entrainment towards +x).
-        p: pressure, Pa. h: film thickness, m. density: ρ, kg/m³. viscosity: η, Pa s.
+        p: pressure, Pa (fluid plus asperity). h: film thickness, m; of the statistical film
+            the separation of the surfaces' mean planes (negative where they overlap).
+        gap: the film that carries the flow, m: the average gap h_T(h) of the statistical film
+            (``asperity.average_gap``), h itself otherwise.
+        density: ρ, kg/m³. viscosity: η, Pa s (both at the fluid's pressure).
         shear_viscosity: η_s of the shear model's stress (η, η* or τ h/us), Pa s: friction
             τ = η_s us/h.
         temperature: mean film temperature ϕm at the nodes, K (the inlet temperature: isothermal).
@@ -24,19 +28,24 @@ class EHLSolution(eqx.Module):
         heat_partition: ϑ = Q1/Q, share of the heat conducted into gear 1 (½ isothermal).
         heat_flux: Q of paper Eq. (12), W/m² = heat_flux_sliding (fluid shear) + heat_flux_rolling
             (Poiseuille) + heat_flux_asperity (μb p |us| in contact).
-        contact: asperity-contact indicator at the nodes, 0 … 1 (smooth; deterministic mixed).
-        asperity_pressure: statistical asperity pressure at the nodes, Pa (included in p).
+        contact: asperity-contact share at the nodes, 0 … 1: the indicator of a deterministic
+            film, the real contact area ratio A_r/A of the statistical film, 0 smooth.
+        asperity_pressure: statistical (Greenwood-Tripp) asperity pressure at the nodes, Pa
+            (included in p).
         h_min, h_central: minimum and central (x = 0) film, m. h0: film offset, m. p_max: Pa.
         (In the cavitated outlet the gap is partly filled: the shear terms are weighted by the fill
         fraction q/(um ρ h), q the mass flux through x = 0, as in a JFO/Elrod streak model.)
-        friction_sliding: Fs = ∫ η_s (u2 − u1)/h dx, N/m (paper Eq. 15, fluid part; sign of Eq. 15).
-            It includes the boundary friction ∫ μb p dx of asperity contact, friction_asperity.
+        friction_sliding: Fs = ∫ (1 − A) η_s (u2 − u1)/h dx, N/m (paper Eq. 15, fluid part, A the
+            contact share, h the gap; sign of Eq. 15). It includes the boundary friction of
+            asperity contact, friction_asperity: ∫ μb p dx over closed nodes (deterministic),
+            ∫ μb p_a dx (statistical).
         friction_rolling: Fr = ∫ (h/2) ∂p/∂x dx over the fluid, N/m (paper Eq. 15).
         damping: cm = ∫ η_s/h dx over the fluid, N s/m² (paper Eq. 13 per unit width).
         power_loss: ∫ Q dx, W/m; power_loss_sliding: fluid shear plus asperity friction;
             power_loss_rolling: Poiseuille part; power_loss_asperity: the asperity part alone.
         contact_fraction: share of the Hertz zone |x| ≤ b in asperity contact.
-        contact_load: ∫ p dx over contact nodes, N/m (``contact_load_share``: its share).
+        contact_load: the load on the asperities, N/m: ∫ p dx over contact nodes, ∫ p_a dx
+            (statistical) (``contact_load_share``: its share).
         plastic_gap: the gap the yielded surfaces opened where p reached ``EHLModel.hardness``,
             m (included in h; zero without a hardness).
         load_error: (∫ p dx − w')/w'.
@@ -50,6 +59,7 @@ class EHLSolution(eqx.Module):
     x: Float[Array, " N"]
     p: Float[Array, " N"]
     h: Float[Array, " N"]
+    gap: Float[Array, " N"]
     density: Float[Array, " N"]
     viscosity: Float[Array, " N"]
     shear_viscosity: Float[Array, " N"]
@@ -115,5 +125,6 @@ class EHLSolution(eqx.Module):
 
     @property
     def rho_h(self):
-        """ρ h at the nodes, kg/m² (the previous-step input of a transient solve)."""
-        return self.density * self.h
+        """ρ h at the nodes, kg/m², h the film that carries the flow (``gap``): the
+        previous-step input of a transient solve."""
+        return self.density * self.gap

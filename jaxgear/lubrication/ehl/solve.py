@@ -171,11 +171,17 @@ def _solve_entry(
         if temperature_rise is None
         else jnp.broadcast_to(jnp.asarray(temperature_rise, dtype=dtype), (n,))
     )
-    z = jnp.zeros((n,), dtype=dtype)
-    seed = z
-    if mixed == "statistical" and initial is not None:
-        seed = jnp.interp(x_here, initial.x, initial.asperity_pressure)
-    inp = _Inputs(contact, lubricant, rho_h_prev, inv_dt, offset, rise, seed, sigma, numbers)
+    inp = _Inputs(
+        contact,
+        lubricant,
+        rho_h_prev,
+        inv_dt,
+        offset,
+        rise,
+        sigma,
+        numbers,
+        mean_plane=mixed == "statistical",
+    )
     if initial is not None:
         args = _warm_args(initial, mixed == "deterministic", moved=previous is not None)
         return _solve_impl(model, True, mixed, inp, *args, solids)[0]
