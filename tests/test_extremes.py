@@ -139,9 +139,12 @@ def test_quasi_static_full_factorial(friction):
         assert np.all(np.asarray(res.power_loss_rolling) > 0.0)
         # ... and Greenwood-Tripp asperity contact: no asperity friction on ideally smooth
         # surfaces, so roughness scale 3 never loses less than scale 0 at the same other settings
-        # (equal where the film is thick enough that the asperities do not touch).
+        # (equal where the film is thick enough that the asperities do not touch, up to the rough
+        # film's flow-factor thickening σ g(λ): at 20000 rpm and 20 °C, λ ≈ 10, it lowers the
+        # fluid shear by 2e-6 … 4e-5 of the loss; bound 1e-4).
         less = np.zeros(rough.size, dtype=bool)
-        less[rough == 3.0] = res.power_loss[rough == 3.0] < res.power_loss[rough == 0.0]
+        smooth_loss = np.asarray(res.power_loss[rough == 0.0])
+        less[rough == 3.0] = np.asarray(res.power_loss[rough == 3.0]) < smooth_loss * (1 - 1e-4)
         assert not less.any(), "rougher but lower loss:\n" + describe(inputs, res, less)
         return
     # The formula rungs model sliding loss only.

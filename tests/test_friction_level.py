@@ -11,6 +11,8 @@ compilation (~25 s of CPU each), so the default run compiles one; the monotone s
 import re
 import tomllib
 
+import equinox as eqx
+import jax.numpy as jnp
 import numpy as np
 import pytest
 from ehl_cases import gear_contact, greenwood_tripp_pressure
@@ -121,20 +123,24 @@ def test_deep_mixed_asperity_pressure_is_greenwood_tripp_of_the_given_parameters
     # a deep mixed contact: asperities carry a large share of the load (measured 0.47)
     assert float(sol.contact_load_share) > 0.2
     assert carried.max() > 0.1 * ph
-    # the outer (Picard) asperity iteration stops once its update is < 1e-3 ph: agreement to 2e-3
-    # ph; the default parameters' pressure is off by ~0.3 ph, 100 × that
-    assert np.max(np.abs(carried - given)) < 2e-3 * ph
+    # the asperity pressure is solved with the film (one Newton system): agreement to 1e-6 ph (the
+    # library's Gauss-Legendre F_{5/2} against scipy's adaptive quadrature); the default
+    # parameters' pressure is off by ~0.3 ph
+    assert np.max(np.abs(carried - given)) < 1e-6 * ph
     assert np.max(np.abs(carried - default)) > 0.1 * ph
 
 
 def test_thick_film_parameters_change_nothing(toml_model):
     """Polished at 8000 rpm (λ ≈ 4: full film) the asperities carry nothing even with K′ 5.7 × the
-    default's: the solution equals the one with the roughness scaled away (σ → 0: no asperity
-    contact for ANY nβσ, σ/β). Since p_a ∝ K′ at a given film, every smaller K′, the defaults
-    included, lies between the two: the parameters change nothing there."""
+    default's: the solution equals the one with K′ 64 × smaller (nβσ 0.01) on the same surfaces
+    (the same flow factor). Since p_a ∝ K′ at a given film, every K′ between, the defaults
+    included, lies between the two: the parameters change nothing there. (Much smaller K′, nβσ ≲
+    1e-3, leaves the statistical film without asperity support and its Newton solve fails: a known
+    limitation, reported as not converged.)"""
     c = gear_contact(rpm=8000.0)
     rough = jg.solve_ehl(c, LUB, toml_model, jg.presets.polished())
-    none = jg.solve_ehl(c, LUB, toml_model, jg.presets.polished(scale=1e-3))
+    off = eqx.tree_at(lambda m: m.asperity_density_product, toml_model, jnp.asarray(0.01))
+    none = jg.solve_ehl(c, LUB, off, jg.presets.polished())
     assert bool(rough.converged) and bool(none.converged)
     sigma = float(jg.presets.polished().composite_rq)
     lam = float(rough.h_min) / sigma
@@ -142,8 +148,7 @@ def test_thick_film_parameters_change_nothing(toml_model):
     # The closed-form asperity pressure at the thinnest film bounds the asperity load: p_a/ph below
     # 1e-6 here. Its boundary friction μb p_a over the ~2b contact changes the sliding friction
     # (μ_fluid ≈ 0.005 × the load (π/2) ph b) by < (4/π)(μb/μ_fluid)(p_a/ph) ≈ 3e-5 relative;
-    # rtol 1e-4 allows for that. (The solver's outer iteration drops asperity pressures below
-    # 1e-3 ph altogether, so in practice the two solutions are identical.)
+    # rtol 1e-4 allows for that.
     pa_max = greenwood_tripp_pressure([rough.h_min], sigma, float(c.e_reduced), 0.08, 0.05)[0]
     assert pa_max < 1e-6 * float(rough.hertz_pressure)
     assert float(rough.contact_load_share) < 1e-5

@@ -479,7 +479,10 @@ class Fidelity(eqx.Module):
         """``paper()`` with its two open contact parameters set to the paper's loss level: the
         Eyring stress as the fluid traction (``shear="eyring_split"``) and the Greenwood-Tripp
         density product nβσ = 0.08 (``asperity_density_product``; 0.05 in ``paper()``), chosen
-        by hand so that the quasi-static Φ̄ at A, B, D, E meets the paper's. A fitted preset,
+        by hand so that the quasi-static Φ̄ at A, B, D, E met the paper's with the statistical
+        film of the mean film. On the mean plane (the film that carries the flow is the average
+        gap, ``EHLModel.mixed``) the same constants give 1.12, 1.06, 0.87 and 0.86 of the
+        paper's 276, 302, 526, 532 W (310, 321, 455, 459 W); they are not refitted. A fitted preset,
         like the calibrated blanks of ``presets.li2015_pair_calibrated()``: use it to study the
         paper's trends at the paper's loss level, not as a check of that level (docs,
         validation)."""
