@@ -84,9 +84,11 @@ def main():
     parser.add_argument("--old", type=Path, default=ROOT.parent / "old")
     args = parser.parse_args()
     trees = {"before": args.old.resolve(), "mean plane": ROOT}
+    load = os.getloadavg()[0]
     results = {name: probe(root) for name, root in trees.items()}
     lines = [
-        f"Measured on {machine()}; compilation cache off, one process per tree.",
+        f"Measured on {machine()}; compilation cache off, one process per tree; load average "
+        f"{load:.1f} at the start (on 2 cores: above 1, the times are another job's as well).",
         "",
         "Solve time of one contact (2000 rpm, ground), compile + first run and the median of 5 "
         "runs (warm: the same program), s:",

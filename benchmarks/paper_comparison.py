@@ -55,7 +55,8 @@ def main(fidelity_name: str = "fast") -> None:
         f"## The paper's results beside jaxgear (`benchmarks/paper_comparison.py`, {fidelity_name})",
         "",
         f"Machine: {machine()}. Preset: {'li2015_pair_calibrated' if calibrated else 'li2015_pair'}; "
-        f"fidelity {fid}. Sweep wall time (both models, with compilation): {wall:.0f} s. "
+        f"fidelity {fidelity_name} ({fid.contact.friction} contacts). "
+        f"Sweep wall time (both models, with compilation): {wall:.0f} s. "
         f"Tribo-dynamic points without a stable periodic orbit, reported as means over the "
         f"attractor the gears settle on (status 6): {int(np.sum(td.on_attractor))} "
         f"({bands(speeds, td.on_attractor)} rpm). Points not converged: "
