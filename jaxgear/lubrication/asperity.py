@@ -34,17 +34,26 @@ from jax.scipy.special import erfc
 
 from .reynolds import smooth_positive
 
-_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(160)
+_RULES = {q: np.polynomial.legendre.leggauss(q) for q in (48, 160)}
+_FAR = 12.0  # λ above which F_n is taken as 0 (F_{5/2}(12) ≈ 1e-36)
 
 
-def gt_integral(order: float, lam):
-    """F_n(λ) = (2π)^(−½) ∫_λ^∞ (s − λ)^n exp(−s²/2) ds, any λ (array), n > −1."""
+def gt_integral(order: float, lam, points: int = 160):
+    """F_n(λ) = (2π)^(−½) ∫_λ^∞ (s − λ)^n exp(−s²/2) ds, any λ (array), n > −1, by
+    Gauss-Legendre quadrature of ``points`` (160: to ~1e-11 relative for n = 5/2 on
+    λ ∈ [−6, 6]; 48: to ~1e-7, what the EHL solver's residual uses)."""
     lam = jnp.asarray(lam)
+    nodes, weights = _RULES[points]
+    # beyond λ = 12, F_n < 1e-33: zero. Why cut: the integrand's exp(−(λ + t)²/2) would pass
+    # through the subnormal range (λ + t ≈ 38) at the thick inlet films of an EHL grid, and
+    # arithmetic on subnormals is ~100 × slower on x86 (it slowed a 257-node solve 20×)
+    far = lam > _FAR
+    lam = jnp.where(far, _FAR, lam)
     span = 9.0 + jnp.maximum(-lam, 0.0)  # the Gaussian tail beyond λ + span is < 1e-18
-    t = 0.5 * (_NODES + 1.0) * span[..., None]  # (…, q) quadrature points on [0, span]
-    w = 0.5 * _WEIGHTS * span[..., None]
+    t = 0.5 * (nodes + 1.0) * span[..., None]  # (…, q) quadrature points on [0, span]
+    w = 0.5 * weights * span[..., None]
     f = t**order * jnp.exp(-0.5 * (lam[..., None] + t) ** 2)
-    return jnp.sum(w * f, axis=-1) / math.sqrt(2.0 * math.pi)
+    return jnp.where(far, 0.0, jnp.sum(w * f, axis=-1) / math.sqrt(2.0 * math.pi))
 
 
 def asperity_constant(density_product, slope_ratio):
@@ -78,7 +87,11 @@ def average_gap(d, sigma):
     (m, any sign) of surfaces of composite roughness σ (m, > 0). h_T(0) = σ/√(2π); h_T → d for
     d ≫ σ (relative difference ≈ φ(λ)/λ³); h_T → 0 for d ≪ −σ."""
     lam = d / sigma
-    return sigma * (lam * normal_cdf(lam) + normal_pdf(lam))
+    # outside |λ| ≤ 12 the gap is d or 0 to 1e-33 of σ (and Φ, φ there would pass through the
+    # subnormal range, slow on x86: see ``gt_integral``)
+    inner = jnp.clip(lam, -_FAR, _FAR)
+    gap = sigma * (inner * normal_cdf(inner) + normal_pdf(inner))
+    return jnp.where(lam > _FAR, d, jnp.where(lam < -_FAR, 0.0, gap))
 
 
 _INVERSE_ITERATIONS = 40
