@@ -76,21 +76,30 @@ def test_passage_of_a_bump_converges_at_the_order_of_its_time_scheme(scheme, ban
     # 0.09 nm, backward Euler's 0.22). The bands allow the pre-asymptotic range and exclude the
     # other order
     model = jg.EHLModel(n_nodes=129, mixed="deterministic", time_scheme=scheme)
-    e2, e4 = _bump_errors(model, lambda sols: sols.h[-1])
+    e2, e4 = _bump_errors(model, lambda sols, k: sols.h[k])
     assert band[0] < e2 / e4 < band[1], (e2, e4)
+
+
+# States of every bump passage below: all three refinements march the same number of states (the
+# Δt/8 passage's 24·8 + 1), so they run one compiled program (a passage's program is compiled per
+# number of states: three lengths cost two more compilations, ~20 s each, against ~2 s for the
+# extra steps). The coarser ones are read at their state 24·refine, 24 Δt in; a passage marches
+# forward in time, so the states after it do not change it.
+BUMP_STATES = 24 * 8 + 1
 
 
 def _bump_errors(model, field):
     """The bump's passage (sliding 0.3, 2000 rpm, 24 Δt = 24 Δx/ur from −2.5 b) at Δt/2, Δt/4 and
-    Δt/8: the largest differences of ``field(solutions)`` at Δt/2 and Δt/4 from that at Δt/8."""
+    Δt/8: the largest differences of ``field(solutions, k)`` (state k, 24 Δt in) at Δt/2 and Δt/4
+    from that at Δt/8."""
     c = gear_contact(rpm=2000.0, slide_to_roll=0.3)
     dt = float(grid_time_step(c, LUB, model))
     surf = bump_surfaces(float(c.hertz_half_width))
     fields = []
     for refine in (2, 4, 8):
-        sols = held_passage(model, c, LUB, surf, dt / refine, 24 * refine + 1)
+        sols = held_passage(model, c, LUB, surf, dt / refine, BUMP_STATES)
         assert bool(jnp.all(sols.converged))
-        fields.append(np.asarray(field(sols)))
+        fields.append(np.asarray(field(sols, 24 * refine)))
     return np.max(np.abs(fields[0] - fields[2])), np.max(np.abs(fields[1] - fields[2]))
 
 
@@ -105,7 +114,7 @@ def test_thermal_passage_of_a_bump_converges_at_first_order_with_tight_temperatu
     model = jg.EHLModel(
         n_nodes=129, mixed="deterministic", thermal=True, thermal_rtol=1e-4, thermal_atol=1e-4
     )
-    e2, e4 = _bump_errors(model, lambda sols: sols.temperature[-1])
+    e2, e4 = _bump_errors(model, lambda sols, k: sols.temperature[k])
     assert 2.2 < e2 / e4 < 4.0, (e2, e4)
 
 
@@ -168,6 +177,11 @@ def test_solid_field_is_read_at_the_bulk_before_the_inlet_and_extrapolated_past_
         np.testing.assert_allclose(read[:, 1], -expected, rtol=0, atol=1e-12)
 
 
+# States of the load-jump passage below (40 warm, 1 jumped); the rising-load passage after it marches
+# as many, so that the two (same model) run one compiled program
+LOAD_JUMP_STATES = 41
+
+
 def test_solids_behind_the_outlet_keep_their_heat_when_the_load_jumps():
     # A thermal smooth pitch contact (65 nodes, 2000 rpm, SRR 0.3) marched 40 steps of Δt = Δx/ur
     # to a settled outlet, then the load doubled in one step: the grid's outlet moves ~4 cells
@@ -180,7 +194,7 @@ def test_solids_behind_the_outlet_keep_their_heat_when_the_load_jumps():
     c = gear_contact(rpm=2000.0, slide_to_roll=0.3)
     model = jg.EHLModel(n_nodes=65, thermal=True)
     dt = float(grid_time_step(c, LUB, model))
-    warm = 40
+    warm = LOAD_JUMP_STATES - 1
     factor = np.concatenate([np.ones(warm), [2.0]])
     contacts = jax.tree_util.tree_map(lambda a: jnp.full(factor.shape, a), c)
     contacts = eqx.tree_at(
@@ -209,18 +223,23 @@ def test_outlet_film_temperature_follows_its_neighbours_under_a_rising_load():
     model = jg.EHLModel(n_nodes=65, thermal=True)
     dt = float(grid_time_step(c, LUB, model))
     t = np.arange(13) * dt
-    factor = np.concatenate([[1.0], 1.0 + 0.15 * (1.0 - np.cos(np.pi * t / (12.0 * dt)))])
+    rising = 1.0 + 0.15 * (1.0 - np.cos(np.pi * t / (12.0 * dt)))
+    # then the load held for the rest of LOAD_JUMP_STATES (the load-jump test's program): a
+    # passage marches forward in time, so state 13, the end of the rise, is what it was without
+    held = LOAD_JUMP_STATES - 1 - t.size
+    factor = np.concatenate([[1.0], rising, np.full(held, rising[-1])])
     contacts = jax.tree_util.tree_map(lambda a: jnp.full(factor.shape, a), c)
     contacts = eqx.tree_at(
         lambda k: k.load_per_width, contacts, jnp.asarray(float(c.load_per_width) * factor)
     )
     warm = 64.0 * dt
+    t = np.concatenate([t, t[-1] + dt * np.arange(1, held + 1)])
     times = jnp.asarray(np.concatenate([[0.0], warm + t]))
     sols = solve_ehl_passage(
         contacts, LUB, model, times=times, displacement=(-float(c.u1) * warm, -float(c.u2) * warm)
     )
     assert bool(jnp.all(sols.converged))
-    rise = np.asarray(sols.temperature[-1]) - float(c.inlet_temperature)
+    rise = np.asarray(sols.temperature[13]) - float(c.inlet_temperature)
     assert rise[-1] > 1.0  # a hot outlet, where the pull shows
     continued = 2.0 * rise[-2] - rise[-3]
     assert abs(rise[-1] - continued) < 0.05 * rise[-1], (rise[-1], continued)
@@ -335,8 +354,13 @@ def test_passage_first_state_has_the_surfaces_at_the_given_displacement():
     surf = bump_surfaces(b, start=-0.5)
     dt = float(grid_time_step(c, LUB, model))
     d = (3e-6, -2e-6)
-    contacts = jax.tree_util.tree_map(lambda a: jnp.full((2,), a), c)
-    sols = solve_ehl_passage(contacts, LUB, model, surf, times=jnp.arange(2) * dt, displacement=d)
+    # the passage of the BDF2 bump test above (its model, BUMP_STATES states), whose compiled
+    # program it reuses: the first state is steady, so neither the time scheme nor the later
+    # states enter it
+    marched = jg.EHLModel(n_nodes=129, mixed="deterministic", time_scheme="bdf2")
+    contacts = jax.tree_util.tree_map(lambda a: jnp.full((BUMP_STATES,), a), c)
+    times = jnp.arange(BUMP_STATES) * dt
+    sols = solve_ehl_passage(contacts, LUB, marched, surf, times=times, displacement=d)
     steady = jg.solve_ehl(c, LUB, model, surf, displacement=d)
     assert bool(sols.converged[0]) and bool(steady.converged)
     # the same discrete problem to the Newton tolerance (1e-9 of ph): films equal to 1e-6 of h_c
