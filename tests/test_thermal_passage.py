@@ -24,8 +24,9 @@ def _held_passage(model, contact, steps):
     return solve_ehl_passage(contacts, LUB, model, ground(), times=jnp.arange(steps) * dt)
 
 
-def test_thermal_deterministic_passage_converges_hot_and_below_the_iso_thermal_loss():
-    # 3500 rpm, 700 N m, SRR 0.3, 257 nodes, 12 steps of Δx/ur (the roughness moves 12 cells).
+def _thermal_deterministic_passage_converges_hot_and_below_the_iso_thermal_loss(n_nodes):
+    # 3500 rpm, 700 N m, SRR 0.3, 257 nodes (129 in the default run's sibling), 12 steps of Δx/ur
+    # (the roughness moves 12 cells).
     # Every step converges (Reynolds and its temperature fixed point, the surface temperatures
     # carried with memory from step to step). The film is hot (the steady film there: hottest
     # node ~180 K above the inlet, measured 2026-11-27) and, with the same roughness in the same
@@ -37,9 +38,9 @@ def test_thermal_deterministic_passage_converges_hot_and_below_the_iso_thermal_l
     # (measured 2026-11-27; an engagement starts at the light-load entry instead, where 32 do)
     c = gear_contact(rpm=3500.0)
     steps = 12
-    model = jg.EHLModel(n_nodes=257, mixed="deterministic", thermal=True, thermal_iterations=64)
+    model = jg.EHLModel(n_nodes=n_nodes, mixed="deterministic", thermal=True, thermal_iterations=64)
     thermal = _held_passage(model, c, steps)
-    iso = _held_passage(jg.EHLModel(n_nodes=257, mixed="deterministic"), c, steps)
+    iso = _held_passage(jg.EHLModel(n_nodes=n_nodes, mixed="deterministic"), c, steps)
     assert bool(jnp.all(thermal.converged)), np.asarray(thermal.residual)
     assert bool(jnp.all(iso.converged))
     for field in (thermal.p, thermal.h, thermal.temperature, thermal.surface_temperature1):
@@ -51,6 +52,23 @@ def test_thermal_deterministic_passage_converges_hot_and_below_the_iso_thermal_l
     assert surface[-1] > surface[0]
     ratio = np.asarray(thermal.power_loss / iso.power_loss)
     assert np.all(ratio < 0.8), ratio
+
+
+def test_thermal_deterministic_passage_converges_hot_and_below_the_iso_thermal_loss_on_129_nodes():
+    # The passage below on 129 nodes (the roughness sampled at half the resolution, 12 steps of
+    # that grid's Δx/ur): the same checks and the same bounds. Measured there: every step
+    # converges, the hottest node 134-197 K above the inlet, the loss ratio 0.33-0.54 (0.23-0.32
+    # on 257 nodes), so 0.8 still tells the heat's thinning from an iso-thermal film (1); on 65
+    # nodes it does not (0.61-1.12), so 129 is the coarsest grid the check holds on. ~65 s CPU
+    # from a cold cache against ~90 s on 257 nodes (almost all of it compilation).
+    _thermal_deterministic_passage_converges_hot_and_below_the_iso_thermal_loss(129)
+
+
+# slow: its compilation (~90 s on 2 cores) is most of the file's; the 129-node test above is its
+# default sibling
+@pytest.mark.slow
+def test_thermal_deterministic_passage_converges_hot_and_below_the_iso_thermal_loss():
+    _thermal_deterministic_passage_converges_hot_and_below_the_iso_thermal_loss(257)
 
 
 def test_a_deterministic_steps_temperature_start_is_the_previous_film_temperature_moved_by_ur_dt():
