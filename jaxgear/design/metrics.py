@@ -30,6 +30,8 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
+from ..contact.base import safe_sqrt as _guarded_sqrt
+
 #: Scalar quantities per point → (unit, sense of "better": +1 larger, −1 smaller).
 SCALARS = {
     "efficiency": ("-", +1),
@@ -47,12 +49,6 @@ FIELDS = {
 QUANTITIES = {**SCALARS, **FIELDS}
 
 _BLOK = 1.11
-
-
-def _guarded_sqrt(x):
-    """√x with a zero (not NaN) derivative at x = 0."""
-    positive = x > 0.0
-    return jnp.where(positive, jnp.sqrt(jnp.where(positive, x, 1.0)), 0.0)
 
 
 def flash_temperature(result, pair):
