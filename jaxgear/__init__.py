@@ -51,7 +51,8 @@ from .operating import OperatingPoint as OperatingPoint
 from .optimise import OptimisationResult as OptimisationResult
 from .optimise import optimise as optimise_bounded
 from .optimise import optimise_roughness_scale as optimise_roughness_scale
-from .optimise import optimise_tip_relief as optimise_tip_relief
+from .design.tip_relief import DesignResult as DesignResult
+from .design.tip_relief import optimise_tip_relief as optimise_tip_relief
 from .optimise import optimise_torque as optimise_torque
 from .results import Status as Status
 from .sweep import SweepResult as SweepResult

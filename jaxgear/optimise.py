@@ -1,8 +1,9 @@
-"""Design optimisation with optax: tip relief, torque and roughness scale for efficiency.
+"""Bounded single-objective optimisation with optax: torque and roughness scale for efficiency.
 
 One generic bounded optimiser, ``optimise(objective, x0, bounds)``, maximises a scalar objective of a
-few design parameters; ``optimise_tip_relief``, ``optimise_torque`` and ``optimise_roughness_scale``
-build the objective (the mean efficiency over a set of speeds) and call it.
+few design parameters; ``optimise_torque`` and ``optimise_roughness_scale`` build the objective (the
+mean efficiency over a set of speeds) and call it. Tip relief, with objectives beside efficiency
+and constraints, is ``jaxgear.design.optimise_tip_relief``.
 
 Numerics:
 
@@ -14,9 +15,9 @@ Numerics:
   ascent). A bound is reached exactly, which matters here: on the quasi-static rung the efficiency
   rises monotonically with relief amount, so the amount optimum is on its bound, where a sigmoid
   reparametrisation would only creep towards it with a vanishing gradient.
-- **Gradients in forward mode** (``jax.jacfwd``: two to four parameters, and ``simulate`` is
-  differentiable in forward mode only, because the periodic-orbit solver has a custom JVP rule). The
-  value, gradient and convergence flag of each step come from one jitted call.
+- **Gradients in forward mode** (``jax.jacfwd``: one to a few parameters, where one forward pass
+  per parameter costs less than a reverse pass). The value, gradient and convergence flag of each
+  step come from one jitted call.
 - **Stationarity** is measured by the projected gradient g_p = P(u + g) − u (P the clip to the box; g
   the gradient in box units): zero at an interior optimum and at an optimum on a bound. The run counts
   as converged when |g_p| ≤ ``gtol`` · |g_p at the start|.
@@ -44,10 +45,8 @@ import numpy as np
 import optax
 from jaxtyping import Array, Float
 
-from ._validation import check_choice
 from .fidelity import Fidelity
-from .gear.geometry import gear_geometry
-from .gear.pair import RELIEF_SHAPES, GearPair, TipRelief
+from .gear.pair import GearPair
 from .operating import OperatingPoint
 from .results import MESSAGES, Status
 from .tribodynamics import check_inputs, first_pass
@@ -65,8 +64,6 @@ STATUS_NAMES = {
     int(Status.NON_FINITE): "stopped: non-finite objective or gradient (best finite point kept)",
 }
 
-DEFAULT_RELIEF_AMOUNT_BOUNDS = (0.0, 50e-6)  # m
-DEFAULT_START_MARGIN = 0.05  # fraction of each gear's roll-angle range kept clear at both ends
 DEFAULT_ROUGHNESS_BOUNDS = (0.1, 3.0)
 
 
@@ -353,41 +350,6 @@ def _mean_efficiency(pair, lubricant, surfaces, op, speeds, fidelity):
     return jnp.mean(eff), jnp.all(ok)
 
 
-def with_tip_relief(pair: GearPair, x, both_gears: bool) -> GearPair:
-    """``pair`` with relief parameters x substituted (traceable).
-
-    x = (amount m, start rad) for both gears, or (amount₁, amount₂, start₁, start₂) per gear."""
-    x = jnp.asarray(x)
-    if both_gears:
-        amount, start = jnp.stack([x[0], x[0]]), jnp.stack([x[1], x[1]])
-    else:
-        amount, start = x[0:2], x[2:4]
-    return eqx.tree_at(
-        lambda p: (p.tip_relief.amount, p.tip_relief.start_roll_angle), pair, (amount, start)
-    )
-
-
-class TipReliefObjective(eqx.Module):
-    """Mean efficiency over ``speeds_rpm`` as a function of the tip relief parameters (SI).
-
-    Call with x = (amount m, start roll angle rad) (``both_gears``) or
-    (amount₁, amount₂, start₁, start₂); returns (mean efficiency, every point converged)."""
-
-    pair: GearPair
-    lubricant: object
-    surfaces: object
-    op: OperatingPoint
-    speeds_rpm: Float[Array, " N"]
-    fidelity: Fidelity
-    both_gears: bool = eqx.field(static=True)
-
-    def __call__(self, x):
-        pair = with_tip_relief(self.pair, x, self.both_gears)
-        return _mean_efficiency(
-            pair, self.lubricant, self.surfaces, self.op, self.speeds_rpm, self.fidelity
-        )
-
-
 class TorqueObjective(eqx.Module):
     """Mean efficiency over ``speeds_rpm`` as a function of x = (gear 1 torque, N m)."""
 
@@ -437,161 +399,6 @@ def _common_checks(pair, lubricant, surfaces, op, fidelity):
     fidelity = Fidelity.fast() if fidelity is None else fidelity
     check_inputs(pair, lubricant, surfaces, op, fidelity)
     return fidelity
-
-
-def _pair_bounds(name, value, n_gears):
-    """(lo, hi) or per gear ((lo1, hi1), (lo2, hi2)) → arrays lo[2], hi[2]."""
-    arr = np.asarray(value, dtype=float)
-    if arr.shape == (2,):
-        arr = np.stack([arr, arr])
-    if arr.shape != (2, 2):
-        raise ValueError(
-            f"bounds[{name!r}] = {value!r} must be (lower, upper) or per gear "
-            "((lower₁, upper₁), (lower₂, upper₂))"
-        )
-    return arr[:, 0], arr[:, 1]
-
-
-def tip_relief_bounds(pair: GearPair, bounds: dict | None = None, margin=DEFAULT_START_MARGIN):
-    """Validated bounds of relief amount (m) and start roll angle (rad), per gear (arrays [2]).
-
-    Defaults: amount in [0, 50 µm]; start inside each gear's own path of contact (from its start of
-    active profile to its tip) less ``margin`` × that range at both ends (the relief must have a
-    length). Given start bounds must lie inside the gear's path of contact."""
-    bounds = {} if bounds is None else dict(bounds)
-    unknown = set(bounds) - {"amount", "start_roll_angle"}
-    if unknown:
-        raise ValueError(
-            f"unknown bounds key(s) {sorted(unknown)}; valid keys: 'amount', 'start_roll_angle'"
-        )
-    geo = gear_geometry(pair)
-    sap = np.asarray(geo.roll_angle_start_active, dtype=float)
-    tip = np.asarray(geo.roll_angle_tip, dtype=float)
-    a_lo, a_hi = _pair_bounds("amount", bounds.get("amount", DEFAULT_RELIEF_AMOUNT_BOUNDS), 2)
-    span = tip - sap
-    default_start = np.stack([sap + margin * span, tip - margin * span], axis=1)
-    s_lo, s_hi = _pair_bounds("start_roll_angle", bounds.get("start_roll_angle", default_start), 2)
-    for j in range(2):
-        if not (np.isfinite(a_lo[j]) and np.isfinite(a_hi[j])) or not 0.0 <= a_lo[j] < a_hi[j]:
-            raise ValueError(
-                f"bounds['amount'] of gear {j + 1} = ({a_lo[j]:g}, {a_hi[j]:g}) m is invalid; "
-                "valid: 0 <= lower < upper, finite"
-            )
-        if not (np.isfinite(s_lo[j]) and np.isfinite(s_hi[j])) or not s_lo[j] < s_hi[j]:
-            raise ValueError(
-                f"bounds['start_roll_angle'] of gear {j + 1} = ({s_lo[j]:g}, {s_hi[j]:g}) rad is "
-                "invalid; valid: finite lower < upper"
-            )
-        if s_lo[j] < sap[j] or s_hi[j] >= tip[j]:
-            raise ValueError(
-                f"bounds['start_roll_angle'] of gear {j + 1} = ({math.degrees(s_lo[j]):.4g}, "
-                f"{math.degrees(s_hi[j]):.4g}) deg is outside the path of contact of gear {j + 1}; "
-                f"valid range: [{math.degrees(sap[j]):.4g}, {math.degrees(tip[j]):.4g}) deg"
-            )
-    return (a_lo, a_hi), (s_lo, s_hi)
-
-
-def optimise_tip_relief(
-    pair: GearPair,
-    lubricant,
-    surfaces,
-    op: OperatingPoint,
-    *,
-    speeds_rpm=None,
-    fidelity: Fidelity | None = None,
-    bounds: dict | None = None,
-    shape: str | None = None,
-    steps: int = 40,
-    learning_rate: float = 0.1,
-    optimiser: optax.GradientTransformation | None = None,
-    both_gears: bool = True,
-    gtol: float = 1e-2,
-) -> OptimisationResult:
-    """Tip relief (amount, start roll angle) maximising the mean efficiency over a speed range.
-
-    Args:
-        pair, lubricant, surfaces, op: the design and operating point (as for ``simulate``); the
-            pair's tip relief is the start (clipped into the bounds; with ``both_gears`` the mean of
-            the two gears' values).
-        speeds_rpm: gear 1 speeds, rpm [N], over which the efficiency is averaged (default op's).
-        fidelity: Fidelity (default ``Fidelity.fast()``). One compile per distinct fidelity and shape.
-        bounds: {"amount": (lo, hi) m, "start_roll_angle": (lo, hi) rad}, each optionally per gear;
-            defaults in ``tip_relief_bounds``.
-        shape: relief shape "linear" or "parabolic" (static), "both" (optimise each, return the
-            better), or None (the pair's own).
-        steps, learning_rate, optimiser, gtol: see ``optimise`` (learning rate in box widths per step).
-        both_gears: the same relief on both gears (2 parameters) or one per gear (4 parameters).
-
-    Returns:
-        OptimisationResult: ``pair`` is the optimum GearPair; ``amount`` (m) and ``start_roll_angle``
-        (rad) per gear; objective = mean efficiency; parameter names ``tip_relief_amount`` and
-        ``tip_relief_start_roll_angle`` (suffixed _1/_2 per gear).
-    """
-    fidelity = _common_checks(pair, lubricant, surfaces, op, fidelity)
-    _check_steps(steps)
-    if shape == "both":
-        results = [
-            optimise_tip_relief(
-                pair,
-                lubricant,
-                surfaces,
-                op,
-                speeds_rpm=speeds_rpm,
-                fidelity=fidelity,
-                bounds=bounds,
-                shape=s,
-                steps=steps,
-                learning_rate=learning_rate,
-                optimiser=optimiser,
-                both_gears=both_gears,
-                gtol=gtol,
-            )
-            for s in RELIEF_SHAPES
-        ]
-        return max(results, key=lambda r: r.objective)
-    if shape is not None:
-        check_choice("shape", shape, (*RELIEF_SHAPES, "both"))
-        tr = pair.tip_relief
-        pair = eqx.tree_at(
-            lambda p: p.tip_relief,
-            pair,
-            TipRelief(amount=tr.amount, start_roll_angle=tr.start_roll_angle, shape=shape),
-        )
-    speeds = _speeds(speeds_rpm, op)
-    (a_lo, a_hi), (s_lo, s_hi) = tip_relief_bounds(pair, bounds)
-    amount0 = np.asarray(pair.tip_relief.amount, dtype=float)
-    start0 = np.asarray(pair.tip_relief.start_roll_angle, dtype=float)
-    if both_gears:
-        lower = [max(a_lo), max(s_lo)]
-        upper = [min(a_hi), min(s_hi)]
-        if not (lower[0] < upper[0] and lower[1] < upper[1]):
-            raise ValueError(
-                "bounds of the two gears do not overlap; use both_gears=False for per-gear relief"
-            )
-        x0 = [amount0.mean(), start0.mean()]
-        names = ("tip_relief_amount", "tip_relief_start_roll_angle")
-    else:
-        lower = [*a_lo, *s_lo]
-        upper = [*a_hi, *s_hi]
-        x0 = [*amount0, *start0]
-        names = tuple(
-            f"{base}_{j}"
-            for base in ("tip_relief_amount", "tip_relief_start_roll_angle")
-            for j in (1, 2)
-        )
-    objective = TipReliefObjective(pair, lubricant, surfaces, op, speeds, fidelity, both_gears)
-    result = optimise(
-        objective,
-        x0,
-        (lower, upper),
-        steps=steps,
-        learning_rate=learning_rate,
-        optimiser=optimiser,
-        gtol=gtol,
-        names=names,
-    )
-    best_pair = with_tip_relief(pair, jnp.asarray(result.x), both_gears)
-    return dataclasses.replace(result, pair=best_pair, surfaces=surfaces, op=op, fidelity=fidelity)
 
 
 def _scalar_bounds(name, bounds, unit):
@@ -689,16 +496,14 @@ def optimise_roughness_scale(
     return dataclasses.replace(result, pair=pair, surfaces=best, op=op, fidelity=fidelity)
 
 
+from .design.relief import tip_relief_bounds, with_tip_relief  # noqa: E402,F401  (public names kept)
+
 __all__ = [
     "OptimisationResult",
     "STATUS_NAMES",
-    "TipReliefObjective",
     "default_optimiser",
     "optimise",
     "optimise_roughness_scale",
-    "optimise_tip_relief",
     "optimise_torque",
-    "tip_relief_bounds",
     "value_and_gradient",
-    "with_tip_relief",
 ]

@@ -15,9 +15,10 @@ in words. Each result type uses the codes that apply to it:
 | 6 | ATTRACTOR | SimulationResult |
 | 7 | PENDING | SimulationResult (first pass only) |
 | 8 | UNSTABLE | DynamicResponse |
-| 9 | MAX_STEPS | OptimisationResult |
-| 10 | SIMULATION | OptimisationResult |
-| 11 | START | OptimisationResult |
+| 9 | MAX_STEPS | OptimisationResult, DesignResult |
+| 10 | SIMULATION | OptimisationResult, DesignResult |
+| 11 | START | OptimisationResult, DesignResult |
+| 12 | INFEASIBLE | DesignResult |
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ class Status(enum.IntEnum):
     MAX_STEPS = 9
     SIMULATION = 10
     START = 11
+    INFEASIBLE = 12
 
     @property
     def message(self) -> str:
@@ -62,6 +64,7 @@ MESSAGES = {
     Status.MAX_STEPS: "step cap reached before the gradient tolerance",
     Status.SIMULATION: "stopped: a simulation point did not converge (best converged point kept)",
     Status.START: "the start point did not converge; nothing optimised",
+    Status.INFEASIBLE: "stopped with a constraint violated beyond its tolerance (limits not attained)",
 }
 
 
