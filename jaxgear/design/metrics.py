@@ -78,9 +78,7 @@ def quantity(name: str, result, pair):
         return result.hertz_pressure
     if name == "flash_temperature":
         return flash_temperature(result, pair)
-    raise ValueError(
-        f"unknown quantity {name!r}; valid names: {', '.join(QUANTITIES)}"
-    )
+    raise ValueError(f"unknown quantity {name!r}; valid names: {', '.join(QUANTITIES)}")
 
 
 def peak(name: str, value):

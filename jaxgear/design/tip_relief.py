@@ -181,7 +181,9 @@ def _duty_cycle(speeds_rpm, torques, op):
                 f"{name} = {given!r} is empty or not a list; valid: a non-empty list of {unit}"
             )
         if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-            raise ValueError(f"{name} = {arr.tolist()} is out of range; valid range: (0, inf) {unit}")
+            raise ValueError(
+                f"{name} = {arr.tolist()} is out of range; valid range: (0, inf) {unit}"
+            )
         return arr
 
     speeds = values("speeds_rpm", speeds_rpm, op.speed_rpm, "rpm")
@@ -210,9 +212,7 @@ def check_constraints(constraints: Mapping | None) -> dict:
     out = {}
     for name, limit in constraints.items():
         if name not in CONSTRAINTS:
-            raise ValueError(
-                f"unknown constraint {name!r}; valid names: {', '.join(CONSTRAINTS)}"
-            )
+            raise ValueError(f"unknown constraint {name!r}; valid names: {', '.join(CONSTRAINTS)}")
         unit, kind = CONSTRAINTS[name]
         try:
             value = float(limit)
@@ -432,6 +432,7 @@ def _solve(problem, names, x0, limits, op, *, ctol, gtol, max_evaluations):
             history=np.zeros((0, 3)), path=u0[None],
         )  # fmt: skip
         return result_from(problem, outcome, start_out, names, x0, limits, op, start_out)
+
     def evaluate(u, lam, rho):
         out = merit_and_gradient(problem, jnp.asarray(u[0]), jnp.asarray(lam[0]),
                                  jnp.asarray(rho[0]), limits_array)  # fmt: skip
@@ -460,7 +461,7 @@ def optimise_tip_relief(
     shape=None,
     both_gears: bool = True,
     ctol: float = 1e-3,
-    gtol: float = 1e-3,
+    gtol: float = 1e-2,
     max_evaluations: int = 120,
 ) -> DesignResult:
     """The tip relief that optimises ``objective`` over a duty cycle, subject to limits that hold at

@@ -1,4 +1,5 @@
-"""``jaxgear optimise``: tip relief (or torque, or roughness scale) for the best mean efficiency."""
+"""``jaxgear optimise``: tip relief for an objective under limits over a duty cycle (or torque, or
+roughness scale, for the best mean efficiency)."""
 
 from __future__ import annotations
 
@@ -9,10 +10,16 @@ from pathlib import Path
 
 import numpy as np
 
+from jaxgear.design.problem import OBJECTIVES
+
 TARGETS = ("tip_relief", "torque", "roughness_scale")
 FIDELITIES = ("fast", "quasi_static")
 _OPTIMISE_KEYS = {
     "target": str,
+    "objective": str,
+    "constraints": list,
+    "torques_Nm": list,
+    "max_evaluations": int,
     "speeds_rpm": list,
     "steps": int,
     "learning_rate": float,
@@ -27,12 +34,14 @@ _OPTIMISE_KEYS = {
 def register(sub) -> None:
     p = sub.add_parser(
         "optimise",
-        help="optimise tip relief (or torque, roughness scale) for the best mean efficiency",
+        help="optimise tip relief under limits (or torque, roughness scale) over a duty cycle",
         description=(
-            "Maximise the mean efficiency over a set of speeds by gradient-based optimisation "
-            "(optax Adam, forward-mode gradients through the model) of the tip relief amount and "
-            "start roll angle (default), of the torque, or of the roughness scale. Prints JSON; "
-            "with --out also writes optimise.json and a PNG of the history."
+            "Tip relief (default target): the amount and start roll angle that optimise "
+            "--objective over every speed and torque of the duty cycle while each --constraint "
+            "holds at every point (augmented Lagrangian, reverse-mode gradients through the model). "
+            "Torque or roughness scale: the best mean efficiency over the speeds (optax Adam). "
+            "Prints JSON; with --out also writes optimise.json, optimise.csv (tip relief: each "
+            "point's values) and a PNG."
         ),
     )
     p.add_argument("--config", type=Path, help="TOML file with [gear], [operating], [optimise]")
@@ -43,11 +52,36 @@ def register(sub) -> None:
         help="START:STOP:STEP in rpm, stop included if on the grid, e.g. 500:4200:500",
     )
     p.add_argument("--torque", type=float, default=None, help="gear 1 torque, N m (default 700)")
+    p.add_argument(
+        "--torques",
+        default=None,
+        help="comma-separated torques, N m: the duty cycle's (tip relief)",
+    )
+    p.add_argument(
+        "--objective",
+        choices=tuple(OBJECTIVES),
+        default=None,
+        help="tip relief objective (default efficiency: the mean, maximised)",
+    )
+    p.add_argument(
+        "--constraint",
+        action="append",
+        default=None,
+        help="a limit at every point, e.g. dte_rms<=1.5um, hertz_pressure<=1.2GPa, "
+        "flash_temperature<=40K, efficiency>=99.8%% (repeatable)",
+    )
+    p.add_argument(
+        "--max-evaluations", type=int, default=None, help="tip relief evaluation budget (120)"
+    )
     p.add_argument("--target", choices=TARGETS, default=None, help="what to optimise")
     p.add_argument("--shape", choices=("linear", "parabolic", "both"), default=None)
     p.add_argument("--per-gear", action="store_true", help="separate relief for each gear")
-    p.add_argument("--steps", type=int, default=None, help="optimiser step cap (default 40)")
-    p.add_argument("--learning-rate", type=float, default=None, help="box widths per step (0.1)")
+    p.add_argument(
+        "--steps", type=int, default=None, help="torque/roughness: optimiser step cap (default 40)"
+    )
+    p.add_argument(
+        "--learning-rate", type=float, default=None, help="torque/roughness: box widths per step"
+    )
     p.add_argument("--fidelity", choices=FIDELITIES, default="fast")
     p.add_argument("--out", type=Path, default=None, help="directory for optimise.json/.png")
     p.set_defaults(func=run)
@@ -86,6 +120,120 @@ def parse_speeds(speeds: str | None, speed_range: str | None) -> list[float] | N
     return None
 
 
+def _relief_bounds(opt_cfg) -> dict:
+    """[optimise] amount_bounds_um / start_roll_angle_bounds_deg → SI bounds."""
+    bounds = {}
+    if "amount_bounds_um" in opt_cfg:
+        lo, hi = _pair_of_numbers("amount_bounds_um", opt_cfg["amount_bounds_um"])
+        bounds["amount"] = (lo * 1e-6, hi * 1e-6)
+    if "start_roll_angle_bounds_deg" in opt_cfg:
+        lo, hi = _pair_of_numbers(
+            "start_roll_angle_bounds_deg", opt_cfg["start_roll_angle_bounds_deg"]
+        )
+        bounds["start_roll_angle"] = (math.radians(lo), math.radians(hi))
+    return bounds
+
+
+def parse_torques(text, opt_cfg):
+    """--torques "a,b" (or [optimise] torques_Nm) → list of N m, or None."""
+    if text is None and "torques_Nm" in opt_cfg:
+        text = ",".join(str(v) for v in opt_cfg["torques_Nm"])
+    if text is None:
+        return None
+    try:
+        values = [float(v) for v in str(text).split(",") if v.strip()]
+    except ValueError:
+        raise ValueError(f"--torques = {text!r} must be comma-separated numbers (N m)") from None
+    if not values or not all(math.isfinite(v) and v > 0 for v in values):
+        raise ValueError(f"--torques = {text!r} is out of range; valid: torques > 0 N m")
+    return values
+
+
+def design_inputs(args, opt_cfg):
+    """(objective, constraints SI, torques) of a tip relief command, checked before any compile."""
+    from jaxgear.cli.design_args import parse_limits
+    from jaxgear.design.tip_relief import check_objective
+
+    objective = args.objective or opt_cfg.get("objective", "efficiency")
+    check_objective(objective)
+    texts = args.constraint if args.constraint is not None else opt_cfg.get("constraints", [])
+    return objective, parse_limits(texts), parse_torques(args.torques, opt_cfg)
+
+
+def _run_tip_relief(args, opt_cfg, design, model, speeds, fidelity, shape) -> int:
+    import jaxgear as jg
+    from jaxgear.cli.design_args import display
+
+    objective, constraints, torques = design
+    pair, lub, surf, op = model
+    budget = args.max_evaluations or opt_cfg.get("max_evaluations", 120)
+    result = jg.optimise_tip_relief(
+        pair, lub, surf, op, speeds_rpm=speeds, torques=torques, fidelity=fidelity,
+        objective=objective, constraints=constraints, bounds=_relief_bounds(opt_cfg), shape=shape,
+        both_gears=not args.per_gear, max_evaluations=budget,
+    )  # fmt: skip
+    report = design_report(result, args.fidelity)
+    print(json.dumps(report, indent=1))
+    if args.out is not None:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "optimise.json").write_text(json.dumps(report, indent=1))
+        from jaxgear.design.plots import plot_design
+
+        plot_design(result, out / "optimise.png")
+        with (out / "optimise.csv").open("w") as fh:
+            names = list(result.values)
+            labels = [display(n, 0.0)[0] for n in names]
+            fh.write(",".join(["speed_rpm", "torque_Nm", *labels, "status"]) + "\n")
+            for k in range(result.speeds_rpm.size):
+                row = [f"{result.speeds_rpm[k]:g}", f"{result.torques[k]:g}"]
+                row += [f"{display(n, result.values[n][k])[1]:.8g}" for n in names]
+                fh.write(",".join([*row, str(int(result.point_status[k]))]) + "\n")
+    return 0
+
+
+def design_report(result, fidelity_name) -> dict:
+    """A DesignResult as JSON, in display units (µm, degrees, %, GPa)."""
+    from jaxgear.cli.design_args import display
+
+    def variables(x):
+        return {_unit(n)[0]: float(v * _unit(n)[1]) for n, v in zip(result.names, x)}
+
+    def per_point(values):
+        out = {}
+        for name, v in values.items():
+            label = display(name, 0.0)[0]
+            out[label] = [display(name, x)[1] for x in np.ravel(v)]
+        return out
+
+    label, start = display(result.objective, result.objective_start)
+    _, optimum = display(result.objective, result.objective_value)
+    return {
+        "target": "tip_relief",
+        "fidelity": fidelity_name,
+        "objective": result.objective,
+        f"objective_start_{label}": start,
+        f"objective_optimum_{label}": optimum,
+        "speeds_rpm": result.speeds_rpm.tolist(),
+        "torques_Nm": result.torques.tolist(),
+        "limits": {display(n, 0.0)[0]: display(n, v)[1] for n, v in result.limits.items()},
+        "start": variables(result.x_start),
+        "optimum": variables(result.x),
+        "shape": list(result.shape),
+        "values_start": per_point(result.values_start),
+        "values_optimum": per_point(result.values),
+        "multipliers": {n: np.ravel(v).tolist() for n, v in result.multipliers.items()},
+        "point_status": result.point_status.tolist(),
+        "failed_points": result.failed_points,
+        "violation": result.violation,
+        "projected_gradient": result.projected_gradient,
+        "evaluations": result.evaluations,
+        "converged": result.converged,
+        "status": result.status,
+        "status_name": result.message,
+    }
+
+
 def _pair_of_numbers(name, value):
     if len(value) != 2 or not all(isinstance(v, int | float) for v in value):
         raise ValueError(f"optimise.{name} = {value!r} must be [lower, upper]")
@@ -120,6 +268,7 @@ def run(args: argparse.Namespace) -> int:
     # Cheap checks first: bad numbers fail before any geometry or compile work.
     _check_steps(steps)
     _check_positive_float("learning_rate", lr)
+    design = design_inputs(args, opt_cfg) if target == "tip_relief" else None
     pair = gear_pair_from_config(cfg)
     op_cfg = operating_from_config(cfg)
     if args.torque is not None:
@@ -138,19 +287,10 @@ def run(args: argparse.Namespace) -> int:
     common = dict(speeds_rpm=speeds, fidelity=fidelity, steps=steps, learning_rate=lr)
 
     if target == "tip_relief":
-        bounds = {}
-        if "amount_bounds_um" in opt_cfg:
-            lo, hi = _pair_of_numbers("amount_bounds_um", opt_cfg["amount_bounds_um"])
-            bounds["amount"] = (lo * 1e-6, hi * 1e-6)
-        if "start_roll_angle_bounds_deg" in opt_cfg:
-            lo, hi = _pair_of_numbers(
-                "start_roll_angle_bounds_deg", opt_cfg["start_roll_angle_bounds_deg"]
-            )
-            bounds["start_roll_angle"] = (math.radians(lo), math.radians(hi))
-        result = jg.optimise_tip_relief(
-            pair, lub, surf, op, bounds=bounds, shape=shape, both_gears=not args.per_gear, **common
+        return _run_tip_relief(
+            args, opt_cfg, design, (pair, lub, surf, op), speeds, fidelity, shape
         )
-    elif target == "torque":
+    if target == "torque":
         bounds = opt_cfg.get("torque_bounds_Nm")
         bounds = _pair_of_numbers("torque_bounds_Nm", bounds) if bounds is not None else None
         result = jg.optimise_torque(pair, lub, surf, op, bounds=bounds, **common)
@@ -210,6 +350,4 @@ def _report(result, target, speeds, op, fidelity_name):
         "status": result.status,
         "status_name": result.message,
     }
-    if target == "tip_relief":
-        report["shape"] = list(result.shape)
     return report, scales, labels
