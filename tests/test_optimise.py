@@ -1,5 +1,6 @@
-"""Design optimisation: gradients against finite differences, optimum against an independent grid
-search, bounds, status, bad input, the command line.
+"""Design optimisation on the quasi-static rung: tip relief for efficiency (the constrained
+optimiser without constraints), torque and roughness scale; gradients against finite differences,
+optimum against an independent grid search, bounds, status, bad input, the command line.
 
 Default tests use the quasi-static regression rung (compiles in seconds); the tribo-dynamic run is
 marked slow. The objective (mean efficiency over speeds) is re-computed here with plain loops over
@@ -20,7 +21,6 @@ from jaxgear.cli import main
 from jaxgear.fidelity import Fidelity
 from jaxgear.optimise import (
     STATUS_CONVERGED,
-    STATUS_MAX_STEPS,
     STATUS_SIMULATION,
     STATUS_START,
     optimise,
@@ -61,16 +61,16 @@ def mean_efficiency(amount, start_rad, shape="linear", surfaces=SURF, torque=700
 @pytest.fixture(scope="module")
 def relief_run():
     return jg.optimise_tip_relief(
-        jg.presets.li2015_pair(), LUB, SURF, OP, speeds_rpm=SPEEDS, fidelity=QS, steps=40
+        jg.presets.li2015_pair(), LUB, SURF, OP, speeds_rpm=SPEEDS, fidelity=QS
     )
 
 
 def test_gradient_matches_central_differences(relief_run):
     # Steps: 0.01 µm and 1e-5 rad. The objective is smooth there (relief ramp smoothed, regression
     # friction), truncation error ~ h² f''' is < 1e-7 relative; round-off ~ 1e-16/(Δf ~ 1e-7) ~ 1e-9.
-    # So 1e-4 relative tests the forward-mode gradient, not the finite differences.
+    # So 1e-4 relative tests the reverse-mode gradient, not the finite differences.
     amount, start = relief_run.x_start
-    grad = relief_run.history_gradient[0]
+    grad = relief_run.gradient_start
     h = (1e-8, 1e-5)
     fd = [
         (mean_efficiency(amount + h[0], start) - mean_efficiency(amount - h[0], start))
@@ -93,8 +93,8 @@ def test_optimum_beats_start_and_grid_search(relief_run):
     assert lo[1] == pytest.approx(math.radians(14.537) + 0.05 * span, abs=1e-5)
     assert hi[1] == pytest.approx(math.radians(27.171) - 0.05 * span, abs=1e-5)
     # The optimum reported is what simulate gives at the optimum pair.
-    assert r.objective == pytest.approx(mean_efficiency(*r.x), abs=1e-12)
-    assert r.objective > r.objective_start + 1e-4  # 10 µm at 20.9° is far from the best relief
+    assert r.objective_value == pytest.approx(mean_efficiency(*r.x), abs=1e-12)
+    assert r.objective_value > r.objective_start + 1e-4  # 10 µm at 20.9° is far from the best
     grid = [
         mean_efficiency(a, s)
         for a in np.linspace(lo[0], hi[0], 5)
@@ -102,14 +102,14 @@ def test_optimum_beats_start_and_grid_search(relief_run):
     ]
     # At least as good as every grid point (the grid's best is on the 50 µm edge; tolerance 1e-9
     # is round-off of a mean of efficiencies, not optimiser slack).
-    assert r.objective >= max(grid) - 1e-9
+    assert r.objective_value >= max(grid) - 1e-9
     # The optimum pair carries the optimum, on both gears.
     np.testing.assert_allclose(r.amount, [r.x[0], r.x[0]])
     np.testing.assert_allclose(r.start_roll_angle, [r.x[1], r.x[1]])
-    # History: objective, parameters and gradient per accepted step, inside the box.
-    assert r.history_x.shape == (r.steps + 1, 2) == r.history_gradient.shape
-    assert r.status in (STATUS_CONVERGED, STATUS_MAX_STEPS)
-    assert np.all(r.history_x >= lo) and np.all(r.history_x <= hi)
+    # Path: the accepted designs, inside the box; no constraints, so no multipliers.
+    assert r.path.shape[1] == 2 and r.multipliers == {} and r.limits == {}
+    assert r.status == jg.Status.OK, r.message
+    assert np.all(r.path >= lo) and np.all(r.path <= hi)
 
 
 def test_bounds_respected_and_reached():
@@ -121,13 +121,14 @@ def test_bounds_respected_and_reached():
     )
     s = math.radians(21.0)
     assert mean_efficiency(20e-6, s) > mean_efficiency(12e-6, s) > mean_efficiency(5e-6, s)
-    assert np.all(r.history_x[:, 0] >= 5e-6) and np.all(r.history_x[:, 0] <= 20e-6)
-    assert np.all(r.history_x[:, 1] >= math.radians(18) - 1e-15)
-    assert np.all(r.history_x[:, 1] <= math.radians(22) + 1e-15)
+    assert np.all(r.path[:, 0] >= 5e-6) and np.all(r.path[:, 0] <= 20e-6)
+    assert np.all(r.path[:, 1] >= math.radians(18) - 1e-15)
+    assert np.all(r.path[:, 1] <= math.radians(22) + 1e-15)
     assert r.x[0] == 20e-6
     # The unconstrained best start (≈23.1° at 50 µm) lies above this box: it must sit on 22°.
     assert r.x[1] == pytest.approx(math.radians(22.0), abs=1e-9)
-    assert r.gradient_norm <= 1e-2 * r.history_gradient_norm[0] + 1e-15
+    # stationary on the box: the projected gradient (objective scaled to unit start gradient)
+    assert r.projected_gradient <= 1e-2
 
 
 def test_per_gear_relief_and_step_cap():
@@ -138,33 +139,35 @@ def test_per_gear_relief_and_step_cap():
         OP,
         speeds_rpm=SPEEDS,
         fidelity=QS,
-        steps=3,
+        max_evaluations=4,
         both_gears=False,
     )
-    assert r.status == STATUS_MAX_STEPS and not r.converged and r.steps == 3
+    assert r.status == jg.Status.MAX_STEPS and not r.converged and r.evaluations == 4
     assert "step cap" in r.message
-    assert r.history_x.shape == (4, 4)
+    assert r.path.shape[1] == 4
     np.testing.assert_allclose(r.amount, r.value("tip_relief_amount"))
     # Relief on either gear unloads a tooth end where sliding is fastest: both amount gradients are
     # positive at the start (gear 1's tip works in the recess, gear 2's in the approach).
-    g = r.history_gradient[0]
+    g = r.gradient_start
     assert g[0] > 0 and g[1] > 0
-    assert r.objective >= r.objective_start
+    assert r.objective_value >= r.objective_start
     r0 = jg.optimise_tip_relief(
-        jg.presets.li2015_pair(), LUB, SURF, OP, speeds_rpm=SPEEDS, fidelity=QS, steps=0
+        jg.presets.li2015_pair(), LUB, SURF, OP, speeds_rpm=SPEEDS, fidelity=QS, max_evaluations=1
     )
-    assert r0.steps == 0 and r0.objective == r0.objective_start
+    assert r0.evaluations == 1 and r0.objective_value == r0.objective_start
 
 
 def test_shape_both_returns_the_better():
-    kw = dict(speeds_rpm=SPEEDS, fidelity=QS, steps=15)
+    kw = dict(speeds_rpm=SPEEDS, fidelity=QS, max_evaluations=30)
     pair = jg.presets.li2015_pair()
     both = jg.optimise_tip_relief(pair, LUB, SURF, OP, shape="both", **kw)
     lin = jg.optimise_tip_relief(pair, LUB, SURF, OP, shape="linear", **kw)
     par = jg.optimise_tip_relief(pair, LUB, SURF, OP, shape="parabolic", **kw)
-    assert both.objective == max(lin.objective, par.objective)
+    assert both.objective_value == max(lin.objective_value, par.objective_value)
     assert par.shape == ("parabolic", "parabolic")
-    assert par.objective == pytest.approx(mean_efficiency(*par.x, shape="parabolic"), abs=1e-12)
+    assert par.objective_value == pytest.approx(
+        mean_efficiency(*par.x, shape="parabolic"), abs=1e-12
+    )
 
 
 def test_roughness_scale_gradient_and_optimum():
@@ -197,7 +200,7 @@ def test_torque_optimum_within_bounds_and_above_grid():
     assert 400.0 <= r.x[0] <= 1200.0 and float(r.op.torque) == r.x[0]
     start = math.radians(20.9)
     grid = [mean_efficiency(10e-6, start, torque=t) for t in np.linspace(400.0, 1200.0, 9)]
-    assert r.objective >= max(grid) - 1e-9
+    assert r.objective_value >= max(grid) - 1e-9
     assert r.objective == pytest.approx(mean_efficiency(10e-6, start, torque=r.x[0]), abs=1e-12)
 
 
@@ -239,10 +242,15 @@ def test_non_converged_points_are_never_used():
             "path of contact",
         ),
         (dict(bounds={"amont": (0, 1e-5)}), "unknown bounds key"),
-        (dict(steps=-1), "steps = -1"),
-        (dict(steps=2.5), "steps = 2.5"),
-        (dict(learning_rate=0.0), "learning_rate"),
+        (dict(max_evaluations=-1), "max_evaluations = -1"),
+        (dict(ctol=0.0), "ctol = 0.0"),
         (dict(shape="cubic"), "shape = 'cubic'"),
+        (dict(objective="noise"), "objective = 'noise'"),
+        (dict(constraints={"noise": 1.0}), "unknown constraint 'noise'"),
+        (dict(constraints={"dte_rms": -1e-6}), "constraints['dte_rms'] = -1e-06"),
+        (dict(constraints={"efficiency": 99.5}), "constraints['efficiency'] = 99.5"),
+        (dict(speeds_rpm=[]), "speeds_rpm = [] is empty"),
+        (dict(torques=[700.0, 0.0]), "torques = [700.0, 0.0] is out of range"),
         (dict(speeds_rpm=[1000.0, -5.0]), "speeds_rpm"),
         (dict(fidelity="fast"), "fidelity = 'fast' is not valid"),
     ],
@@ -270,8 +278,6 @@ def test_cli_optimise_json_and_png(tmp_path, capsys):
             "quasi_static",
             "--speed-range",
             "1000:4000:1500",
-            "--steps",
-            "40",
             "--out",
             str(tmp_path),
         ]
@@ -279,16 +285,23 @@ def test_cli_optimise_json_and_png(tmp_path, capsys):
     assert rc == 0
     data = json.loads(capsys.readouterr().out)
     assert data["speeds_rpm"] == [1000.0, 2500.0, 4000.0]
-    assert data["start"] == {"tip_relief_amount_um": 10.0, "tip_relief_start_roll_angle_deg": 20.9}
+    assert data["start"] == pytest.approx(
+        {"tip_relief_amount_um": 10.0, "tip_relief_start_roll_angle_deg": 20.9}, rel=1e-12
+    )
     opt = data["optimum"]
     # µm and degrees at this edge: the same numbers as the library's SI optimum.
     assert 0.0 <= opt["tip_relief_amount_um"] <= 50.0
     assert 15.0 < opt["tip_relief_start_roll_angle_deg"] < 26.6
-    assert data["efficiency_optimum_percent"] >= data["efficiency_start_percent"]
+    assert (
+        data["objective_optimum_efficiency_percent"] >= data["objective_start_efficiency_percent"]
+    )
     assert data["status_name"] and data["status"] in (jg.Status.OK, jg.Status.MAX_STEPS)
-    assert data["efficiency_start_percent"] == pytest.approx(
+    assert data["objective_start_efficiency_percent"] == pytest.approx(
         100 * mean_efficiency(10e-6, math.radians(20.9)), abs=1e-10
     )
+    # per point: the efficiency at each speed, in percent
+    assert len(data["values_optimum"]["efficiency_percent"]) == 3
+    assert (tmp_path / "optimise.csv").read_text().count("\n") == 4
     assert json.loads((tmp_path / "optimise.json").read_text()) == data
     assert (tmp_path / "optimise.png").stat().st_size > 1000
 
@@ -328,10 +341,16 @@ def test_tribo_dynamic_optimisation():
     # converged (the optimiser stops otherwise).
     fid = Fidelity(friction="regression")
     r = jg.optimise_tip_relief(
-        jg.presets.li2015_pair(), LUB, SURF, OP, speeds_rpm=(1500.0, 3000.0), fidelity=fid, steps=8
+        jg.presets.li2015_pair(),
+        LUB,
+        SURF,
+        OP,
+        speeds_rpm=(1500.0, 3000.0),
+        fidelity=fid,
+        max_evaluations=16,
     )
-    assert r.status in (STATUS_CONVERGED, STATUS_MAX_STEPS), r.message
-    assert r.objective >= r.objective_start
+    assert r.status in (jg.Status.OK, jg.Status.MAX_STEPS), r.message
+    assert r.objective_value >= r.objective_start
     # gradient against central differences of the public simulate (looser than quasi-static: the
     # fixed point is converged to 1e-4 relative, so FD noise ~ 1e-4 · Δ scale; 1e-2 relative)
     amount, start = r.x_start
@@ -348,4 +367,4 @@ def test_tribo_dynamic_optimisation():
 
     h = 2e-7
     fd = (f(amount + h, start) - f(amount - h, start)) / (2 * h)
-    assert r.history_gradient[0][0] == pytest.approx(fd, rel=1e-2)
+    assert r.gradient_start[0] == pytest.approx(fd, rel=1e-2)

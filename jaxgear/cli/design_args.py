@@ -48,8 +48,9 @@ def parse_limit(text: str) -> tuple[str, float]:
     si_unit, kind = CONSTRAINTS[name]
     wanted = ">=" if kind == "lower" else "<="
     if op != wanted:
+        article = "a lower" if kind == "lower" else "an upper"
         raise ValueError(
-            f"--constraint {text!r}: {name} takes a {kind} limit; write {name}{wanted}…"
+            f"--constraint {text!r}: {name} takes {article} limit; write {name}{wanted}…"
         )
     units = UNITS[si_unit]
     if unit not in units:

@@ -25,6 +25,7 @@ import math
 from pathlib import Path
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -252,7 +253,8 @@ def pareto_front(
             "rho": jnp.asarray(rho),
             "limits": jnp.asarray(limit_rows),
         }
-        return run_points(batch_point, inputs, args=problem, converged_key=None, label="pareto")
+        return run_points(batch_point, inputs, args=problem, converged_key=None, label="pareto",
+                          sequential=jax.default_backend() == "cpu")  # fmt: skip
 
     first = batch(np.stack(starts), np.zeros((k_points, n_con)), np.full(k_points, 1e-12))
     out0 = first.outputs

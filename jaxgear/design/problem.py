@@ -113,8 +113,7 @@ class TipReliefProblem(eqx.Module):
             result = first_pass(pair, self.lubricant, self.surfaces, op, self.fidelity)[0]
             return {n: metrics.quantity(n, result, pair) for n in names}, result.status
 
-        values, status = jax.vmap(one)(self.torques, self.speeds_rpm)
-        return values, status
+        return map_points(one, self.torques, self.speeds_rpm)
 
     def objective_value(self, values, u):
         """The objective in natural units (mean over points, or peak)."""
@@ -195,7 +194,16 @@ def evaluate_designs(problem, us):
         values, status = problem.quantities(u)
         return {n: metrics.peak(n, v) for n, v in values.items()}, status
 
-    return jax.vmap(one)(us)
+    return map_points(one, us)
+
+
+def map_points(fn, *xs):
+    """``fn`` over the leading axis of ``xs``: vectorised (``jax.vmap``) on an accelerator, one after
+    the other (``lax.map``) on a CPU, where a vmapped ``lax.cond`` or ``while_loop`` would run every
+    branch and every iteration for every point."""
+    if jax.default_backend() == "cpu":
+        return jax.lax.map(lambda args: fn(*args), xs)
+    return jax.vmap(fn)(*xs)
 
 
 def constraint_count(problem, limits) -> int:

@@ -52,6 +52,8 @@ class DesignResult(eqx.Module):
         objective: the objective's name (an ``OBJECTIVES`` key).
         objective_value, objective_start: its value at the optimum and at the start (natural units:
             the duty-cycle mean, or the peak for the max objectives).
+        gradient_start: ∂objective/∂x at the start, per SI unit of each variable [n] (NaN for the
+            max objectives, whose peak has no single gradient).
         speeds_rpm, torques: the duty cycle's points, rpm and N m [P] (every speed at every torque).
         values, values_start: quantity → its value per point [P] (a field's peak over the mesh
             cycle), for the objective's quantity and every constrained one.
@@ -81,6 +83,7 @@ class DesignResult(eqx.Module):
     objective: str = eqx.field(static=True)
     objective_value: float
     objective_start: float
+    gradient_start: np.ndarray
     speeds_rpm: np.ndarray
     torques: np.ndarray
     values: dict
@@ -379,6 +382,16 @@ def _entries(problem, name) -> int:
     return 2 * problem.fidelity.n_positions if name in FIELDS else 1
 
 
+def _objective_gradient(problem, start_out, n) -> np.ndarray:
+    """∂F/∂x (SI) from the unscaled start evaluation (scale 1, reference 0, λ = 0, ρ → 0, where
+    the merit's gradient is −sense ∂F/∂u)."""
+    if problem.epigraph:
+        return np.full(n, np.nan)
+    sense = OBJECTIVES[problem.objective][2]
+    width = np.asarray(problem.upper - problem.lower)[:n]
+    return -sense * np.asarray(start_out["gradient"], dtype=float)[:n] / width
+
+
 def result_from(problem, outcome, start_out, names, x0, limits, op, final_out) -> DesignResult:
     """The DesignResult of a search's outcome (``final_out``: the merit output at its optimum)."""
     n = len(names)
@@ -396,6 +409,7 @@ def result_from(problem, outcome, start_out, names, x0, limits, op, final_out) -
         objective=problem.objective,
         objective_value=float(final_out["objective"]),
         objective_start=float(start_out["objective"]),
+        gradient_start=_objective_gradient(problem, start_out, n),
         speeds_rpm=np.asarray(problem.speeds_rpm),
         torques=np.asarray(problem.torques),
         values={k: np.asarray(v) for k, v in final_out["peaks"].items()},
