@@ -51,6 +51,8 @@ from .operating import OperatingPoint as OperatingPoint
 from .optimise import OptimisationResult as OptimisationResult
 from .optimise import optimise as optimise_bounded
 from .optimise import optimise_roughness_scale as optimise_roughness_scale
+from .design.pareto import ParetoFront as ParetoFront
+from .design.pareto import pareto_front as pareto_front
 from .design.tip_relief import DesignResult as DesignResult
 from .design.tip_relief import optimise_tip_relief as optimise_tip_relief
 from .optimise import optimise_torque as optimise_torque

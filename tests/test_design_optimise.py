@@ -125,11 +125,12 @@ def test_no_grid_design_beats_the_optimum(constrained, independent):
 
 
 def test_pareto_points_are_non_dominated_and_ordered():
-    # quasi-static rung: efficiency against the peak Hertz pressure, which rises with the relief
-    # amount as the efficiency does
+    # quasi-static rung: efficiency against the static transmission error's RMS (its "DTE"), which
+    # at a 20.9° start falls to ~1.45 µm near 45 µm of relief and rises to ~2.1 µm at 50 µm while the
+    # efficiency keeps rising: a trade
     front = pareto_front(
         jg.presets.li2015_pair(), LUB, SURF, OP, speeds_rpm=[2000.0], fidelity=QS,
-        trade="hertz_pressure", n_points=4, grid=5,
+        trade="dte_rms", n_points=4, grid=5,
     )  # fmt: skip
     assert front.limits.size == 4 and np.all(np.diff(front.limits) > 0)
     assert np.all(front.status == jg.Status.OK), [r.message for r in front.results]
@@ -162,17 +163,18 @@ def test_pareto_bad_input(kwargs, needle):
 def test_cli_optimise_with_a_limit_and_pareto(tmp_path, capsys):
     rc = main(
         ["optimise", "--fidelity", "quasi_static", "--speeds", "2000",
-         "--constraint", "hertz_pressure<=1.15GPa", "--out", str(tmp_path / "opt")]
+         "--constraint", "dte_rms<=1.8um", "--out", str(tmp_path / "opt")]
     )  # fmt: skip
     assert rc == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["limits"] == {"hertz_pressure_GPa": pytest.approx(1.15)}
-    assert max(data["values_optimum"]["hertz_pressure_GPa"]) <= 1.15 * (1 + 1e-3)
+    assert data["limits"] == {"dte_rms_um": pytest.approx(1.8)}
+    assert data["status"] == jg.Status.OK, data["status_name"]
+    assert max(data["values_optimum"]["dte_rms_um"]) <= 1.8 * (1 + 1e-3)
     for name in ("optimise.json", "optimise.csv", "optimise.png"):
         assert (tmp_path / "opt" / name).stat().st_size > 100
     rc = main(
-        ["pareto", "--fidelity", "quasi_static", "--speeds", "2000", "--trade", "hertz_pressure",
-         "--n-points", "3", "--grid", "3", "--out", str(tmp_path / "front")]
+        ["pareto", "--fidelity", "quasi_static", "--speeds", "2000", "--n-points", "3",
+         "--grid", "3", "--out", str(tmp_path / "front")]
     )  # fmt: skip
     assert rc == 0
     data = json.loads(capsys.readouterr().out)

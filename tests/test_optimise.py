@@ -200,7 +200,7 @@ def test_torque_optimum_within_bounds_and_above_grid():
     assert 400.0 <= r.x[0] <= 1200.0 and float(r.op.torque) == r.x[0]
     start = math.radians(20.9)
     grid = [mean_efficiency(10e-6, start, torque=t) for t in np.linspace(400.0, 1200.0, 9)]
-    assert r.objective_value >= max(grid) - 1e-9
+    assert r.objective >= max(grid) - 1e-9
     assert r.objective == pytest.approx(mean_efficiency(10e-6, start, torque=r.x[0]), abs=1e-12)
 
 

@@ -1,2 +1,3 @@
-"""Design tools on top of ``simulate``: constrained and multi-objective tip relief optimisation,
-Pareto fronts, sensitivity reports and calibration of model constants."""
+"""Design tools on top of ``simulate``: constrained and multi-objective tip relief optimisation
+(``optimise_tip_relief``), Pareto fronts (``pareto_front``), sensitivity reports and calibration of
+model constants. The named design quantities are in ``metrics``."""
