@@ -5,11 +5,12 @@ pressure, flash temperature or loss): for each limit ε_k of a sequence, the rel
 objective with trade ≤ ε_k at every point of the duty cycle (and any further constraints). The K
 problems share one structure, so they are stepped in lockstep (``augmented_lagrangian.drive``) and
 each round of K trial designs is one batch through the sweep engine (``sweep.engine.run_points``:
-vectorised, shardable over devices, a failed point kept apart from the good ones).
+vectorised on an accelerator and shardable over devices, one after the other on a CPU; a failed
+point kept apart from the good ones).
 
 Without given limits, a coarse grid of designs over the bounds (``grid`` per variable, values only)
-sets the range: from the smallest trade value a feasible grid design reaches to the trade value of
-the grid design with the best objective. Each problem starts from the best feasible grid design under
+sets the range: from just above the smallest trade value a feasible grid design reaches (5 % of the
+range above it) to the trade value of the grid design with the best objective. Each problem starts from the best feasible grid design under
 its limit. Points that turn out dominated (another point at least as good in both, better in one) are
 flagged, not dropped.
 
@@ -220,71 +221,82 @@ def pareto_front(
     q_obj = peaks[objective_name]
     grid_objective = q_obj.mean(axis=1) if aggregate == "mean" else q_obj.max(axis=1)
     grid_trade = peaks[trade].max(axis=1)
-    if limits is None:
+    default_limits = limits is None
+    if default_limits:
         best = np.argmax(np.where(good, sense * grid_objective, -np.inf))
-        lo = float(np.min(grid_trade[good]))
+        lowest = float(np.min(grid_trade[good]))
         hi = float(grid_trade[best])
-        if not hi > lo:
-            hi = lo * 1.5
-        limits = np.linspace(lo, hi, n_points)
+        if not hi > lowest:
+            hi = lowest * 1.5
+        # not at the lowest value itself: there the feasible set shrinks to a point (no interior,
+        # no constraint qualification) and the multiplier grows without bound
+        limits = np.linspace(lowest + 0.05 * (hi - lowest), hi, n_points)
     limits = np.sort(np.atleast_1d(np.asarray(limits, dtype=float)))
     if limits.ndim != 1 or limits.size == 0 or not np.all(np.isfinite(limits)) or np.any(
             limits <= 0):  # fmt: skip
         raise ValueError(f"limits = {limits.tolist()} are out of range; valid: positive, finite SI")
 
-    starts = []
-    for eps in limits:
-        under = good & (grid_trade <= eps)
-        pool = under if np.any(under) else good
-        pick = np.argmax(np.where(pool, sense * grid_objective, -np.inf))
-        starts.append(grid_u[pick])
-    limit_rows = np.stack(
-        [[eps if n == trade else limit_map[n] for n in problem.constraint_names] for eps in limits]
-    )
-
-    # --- the objective's scale at the first start (shared by every point: one structure) ---
+    starts = [_grid_start(eps, good, grid_trade, grid_objective, sense, grid_u) for eps in limits]
     k_points = limits.size
-    n_con = constraint_count(problem, jnp.asarray(limit_rows[0]))
+    rows = {"limits": _limit_rows(limits, problem.constraint_names, trade, limit_map)}
+    n_con = constraint_count(problem, jnp.asarray(rows["limits"][0]))
 
     def batch(u, lam, rho):
         inputs = {
             "u": jnp.asarray(u),
             "multipliers": jnp.asarray(lam),
             "rho": jnp.asarray(rho),
-            "limits": jnp.asarray(limit_rows),
+            "limits": jnp.asarray(rows["limits"]),
         }
         return run_points(batch_point, inputs, args=problem, converged_key=None, label="pareto",
                           sequential=jax.default_backend() == "cpu")  # fmt: skip
 
+    # --- the objective's scale at the first start (shared by every point: one structure) ---
     first = batch(np.stack(starts), np.zeros((k_points, n_con)), np.full(k_points, 1e-12))
     out0 = first.outputs
+    ref = float(np.asarray(out0["objective"])[0])
     if problem.epigraph:
-        ref = float(np.asarray(out0["objective"])[0])
-        problem = eqx.tree_at(lambda p: (p.reference, p.scale), problem,
-                              (jnp.asarray(ref), jnp.asarray(ref)))  # fmt: skip
+        size = ref
     else:
-        grads = np.asarray(out0["gradient"], dtype=float)
-        size = float(np.nanmax(np.abs(grads)))
+        size = float(np.nanmax(np.abs(np.asarray(out0["gradient"], dtype=float))))
         size = size if math.isfinite(size) and size > 0 else 1.0
-        ref = float(np.asarray(out0["objective"])[0])
-        problem = eqx.tree_at(lambda p: (p.reference, p.scale), problem,
-                              (jnp.asarray(ref), jnp.asarray(size)))  # fmt: skip
+    problem = eqx.tree_at(lambda p: (p.reference, p.scale), problem,
+                          (jnp.asarray(ref), jnp.asarray(size)))  # fmt: skip
 
     def evaluate(u, lam, rho):
         swept = batch(u, lam, rho)
         ok = swept.status == 0
         return [_row_evaluation(swept.outputs, k, ok[k]) for k in range(k_points)]
 
-    searches = [
-        al.search(starts[k], n_con, ctol=ctol, gtol=gtol, max_evaluations=max_evaluations)
-        for k in range(k_points)
-    ]
-    outcomes = al.drive(searches, evaluate)
-    final = batch(
-        np.stack([o.u for o in outcomes]),
-        np.stack([o.multipliers for o in outcomes]),
-        np.asarray([max(o.rho, 1.0) for o in outcomes]),
-    ).outputs
+    def solve(starts, multipliers):
+        searches = [
+            al.search(starts[k], n_con, ctol=ctol, gtol=gtol, max_evaluations=max_evaluations,
+                      multipliers0=multipliers[k])
+            for k in range(k_points)
+        ]  # fmt: skip
+        outcomes = al.drive(searches, evaluate)
+        final = batch(
+            np.stack([o.u for o in outcomes]),
+            np.stack([o.multipliers for o in outcomes]),
+            np.asarray([max(o.rho, 1.0) for o in outcomes]),
+        ).outputs
+        return outcomes, final
+
+    outcomes, final = solve(starts, [None] * k_points)
+    if default_limits:
+        # limits above the unconstrained optimum's trade value all give that optimum: found now,
+        # it is the front's loose end; solve again over the range that binds, warm-started
+        trades = np.max(np.asarray(final["peaks"][trade]).reshape(k_points, -1), axis=1)
+        loose = [k for k, o in enumerate(outcomes)
+                 if o.status == Status.OK and trades[k] < limits[k] * (1 - 10 * ctol)]  # fmt: skip
+        if len(loose) >= 2:
+            limits = np.linspace(limits[0], float(np.min(trades[loose])), k_points)
+            rows["limits"] = _limit_rows(limits, problem.constraint_names, trade, limit_map)
+            warm = [_warm_start(eps, outcomes, trades, sense, ctol) for eps in limits]
+            starts = [outcomes[w].u if w is not None else starts[k] for k, w in enumerate(warm)]
+            multipliers = [outcomes[w].multipliers if w is not None else None for w in warm]
+            outcomes, final = solve(starts, multipliers)
+    limit_rows = rows["limits"]
     start_out = first.outputs
     results = []
     for k, outcome in enumerate(outcomes):
@@ -310,6 +322,28 @@ def pareto_front(
         dominated=dominated_mask(objective_values, trade_values, sense, status == Status.OK),
         results=tuple(results),
     )
+
+
+def _limit_rows(limits, names, trade, limit_map):
+    """Per point, the limits of the problem's constraints in order (the trade's is ε)."""
+    return np.stack([[eps if n == trade else limit_map[n] for n in names] for eps in limits])
+
+
+def _grid_start(eps, good, grid_trade, grid_objective, sense, grid_u):
+    """The best grid design under ε (or the best good one if none is under it)."""
+    under = good & (grid_trade <= eps)
+    pool = under if np.any(under) else good
+    return grid_u[np.argmax(np.where(pool, sense * grid_objective, -np.inf))]
+
+
+def _warm_start(eps, outcomes, trades, sense, ctol):
+    """Index of the best converged solution whose trade value meets ε, or None."""
+    best, index = -np.inf, None
+    for k, o in enumerate(outcomes):
+        value = sense * o.evaluation.objective
+        if o.status == Status.OK and trades[k] <= eps * (1 + ctol) and value > best:
+            best, index = value, k
+    return index
 
 
 def _row(value, k):
