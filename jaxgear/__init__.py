@@ -24,6 +24,8 @@ from .gear.pair import TipRelief as TipRelief
 from .material import Material as Material
 
 __version__ = "0.1.0"
+from .design.calibrate import CalibrationResult as CalibrationResult
+from .design.calibrate import calibrate as calibrate
 from .dynamics import DynamicResponse as DynamicResponse
 from .dynamics import DynamicsOptions as DynamicsOptions
 from .dynamics import MeshInterface as MeshInterface

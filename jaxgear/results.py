@@ -10,15 +10,16 @@ in words. Each result type uses the codes that apply to it:
 | 1 | FIXED_POINT | SimulationResult |
 | 2 | DYNAMICS | SimulationResult, DynamicResponse |
 | 3 | CONTACT | SimulationResult |
-| 4 | NON_FINITE | SimulationResult, DynamicResponse, OptimisationResult |
+| 4 | NON_FINITE | SimulationResult, DynamicResponse, OptimisationResult, CalibrationResult |
 | 5 | FAILED | SweepResult |
 | 6 | ATTRACTOR | SimulationResult |
 | 7 | PENDING | SimulationResult (first pass only) |
 | 8 | UNSTABLE | DynamicResponse |
-| 9 | MAX_STEPS | OptimisationResult, DesignResult |
-| 10 | SIMULATION | OptimisationResult, DesignResult |
-| 11 | START | OptimisationResult, DesignResult |
+| 9 | MAX_STEPS | OptimisationResult, DesignResult, CalibrationResult |
+| 10 | SIMULATION | OptimisationResult, DesignResult, CalibrationResult |
+| 11 | START | OptimisationResult, DesignResult, CalibrationResult |
 | 12 | INFEASIBLE | DesignResult |
+| 13 | RANGE | CalibrationResult |
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ class Status(enum.IntEnum):
     SIMULATION = 10
     START = 11
     INFEASIBLE = 12
+    RANGE = 13
 
     @property
     def message(self) -> str:
@@ -65,6 +67,7 @@ MESSAGES = {
     Status.SIMULATION: "stopped: a simulation point did not converge (best converged point kept)",
     Status.START: "the start point did not converge; nothing optimised",
     Status.INFEASIBLE: "stopped with a constraint violated beyond its tolerance (limits not attained)",
+    Status.RANGE: "a fitted value lies outside its valid range",
 }
 
 
