@@ -27,7 +27,10 @@ Numerics:
   contact or fixed point not converged, a mean over an attractor whose derivatives are NaN) gives a
   NaN residual inside the solve, so the trust region rejects any step onto it; a point failing at
   the start stops the calibration before the solve (status ``START``), one failing at the result
-  marks it (status ``SIMULATION``), and both name the points (``failed_points``, ``message``).
+  marks it (status ``SIMULATION``), and so does one failing at the Gauss-Newton step the solver
+  would still take from the result (a fit held against constants where the simulation fails stops
+  there with every point fine, but not at a minimum). Each names the points (``failed_points``,
+  ``message``).
 - **Standard errors** from the Jacobian J = ∂r/∂θ at the optimum (linearised, natural units):
   cov = s² (JᵀJ)⁻¹ with s² = RSS/(n − p), the residual variance, when the weights are relative
   (``absolute_sigma=False``, the default; scipy's ``curve_fit`` convention). With n = p the fit
@@ -106,6 +109,10 @@ class CalibrationResult(eqx.Module):
         status: see ``STATUS_NAMES``.
         note: what the standard errors rest on, or why they are undefined.
         detail: which points failed, or which value left its range ('' if none).
+        failed_points: indices of the points whose simulation failed: at the start values
+            (status START), at the fitted values, or at the Gauss-Newton step the solver would
+            still take from them (status SIMULATION: the fit stopped against constants where the
+            simulation fails, not at a minimum).
         fidelity: the fidelity with the fitted constants (the input's where a fitted value left
             its range or nothing was fitted).
         surfaces: the surfaces with the fitted roughness scale (the input's otherwise).
@@ -126,6 +133,7 @@ class CalibrationResult(eqx.Module):
     status: int
     note: str = eqx.field(static=True)
     detail: str = eqx.field(static=True)
+    failed_points: tuple[int, ...] = eqx.field(static=True)
     fidelity: Fidelity
     surfaces: Surfaces
 
@@ -155,11 +163,6 @@ class CalibrationResult(eqx.Module):
     def degrees_of_freedom(self) -> int:
         """n − p."""
         return int(self.residuals.size - len(self.names))
-
-    @property
-    def failed_points(self) -> tuple[int, ...]:
-        """Indices of the points whose simulation status is not 0."""
-        return tuple(int(i) for i in np.flatnonzero(np.asarray(self.point_status) != 0))
 
     @property
     def converged(self) -> bool:
@@ -332,7 +335,7 @@ def _per_point(name, value, n, default=None) -> np.ndarray:
     if bad.size:
         i = int(bad[0])
         raise ValueError(
-            f"{name}[{i}] = {arr[i]!r} is out of range; valid range: finite and > 0"
+            f"{name}[{i}] = {float(arr[i])!r} is out of range; valid range: finite and > 0"
             + (" W" if name == "measured_power_loss" else "")
         )
     return arr
@@ -479,7 +482,7 @@ def calibrate(
     if np.any(status0 != 0):
         return _result(
             names, theta0, theta0, jac0, r0, r0, loss0, measured, w, status0, 0, STATUS_START,
-            _failed_detail(status0), model, absolute_sigma,
+            _failed_detail(status0), np.flatnonzero(status0 != 0), model, absolute_sigma,
         )  # fmt: skip
 
     solver = optx.LevenbergMarquardt(rtol=float(rtol), atol=float(atol))
@@ -489,11 +492,19 @@ def calibrate(
     theta = np.exp(np.asarray(eta))
     loss, status, r, jac = residuals_and_jacobian(theta)
 
-    detail = ""
-    if np.any(status != 0):
+    detail, failed = "", np.flatnonzero(status != 0)
+    if failed.size:
         code, detail = STATUS_SIMULATION, _failed_detail(status)
     elif not (np.all(np.isfinite(r)) and np.all(np.isfinite(jac))):
         code = STATUS_NON_FINITE
+    elif probe := _blocked_by_failures(residuals_and_jacobian, theta, r, jac, rtol, atol):
+        # the solver stopped against parameter values where the simulation fails, not at a
+        # minimum: the Gauss-Newton step it would still take from here lands on failed points
+        failed, code = probe[0], STATUS_SIMULATION
+        detail = (
+            f"the Gauss-Newton step from the fitted values fails at {probe[1]}: the fit stopped "
+            "against constants where the simulation fails, not at a minimum"
+        )
     elif _out_of_range(names, theta):
         code, detail = STATUS_RANGE, _out_of_range(names, theta)
     elif solver_result == optx.RESULTS.successful:
@@ -505,8 +516,20 @@ def calibrate(
         detail = f"optimistix: {optx.RESULTS[solver_result]}"
     return _result(
         names, theta, theta0, jac, r, r0, loss, measured, w, status, int(steps), code, detail,
-        model, absolute_sigma,
+        failed, model, absolute_sigma,
     )  # fmt: skip
+
+
+def _blocked_by_failures(evaluate, theta, r, jac, rtol, atol):
+    """(failed point indices, detail) where the Gauss-Newton step δη = −J_η⁺ r from θ, larger
+    than the solver's tolerance, lands on failed points; None otherwise."""
+    eta = np.log(theta)
+    step = -np.linalg.lstsq(jac * theta[None, :], r, rcond=None)[0]
+    if not np.any(np.abs(step) > atol + rtol * np.abs(eta)):
+        return None
+    status = evaluate(theta * np.exp(step))[1]
+    failed = np.flatnonzero(status != 0)
+    return (failed, _failed_detail(status)) if failed.size else None
 
 
 def _failed_detail(status) -> str:
@@ -549,7 +572,7 @@ def covariance(jacobian, residuals, absolute_sigma=False) -> tuple[np.ndarray, s
 
 
 def _result(names, theta, theta0, jac, r, r0, loss, measured, w, status, steps, code, detail,
-            model, absolute_sigma) -> CalibrationResult:  # fmt: skip
+            failed, model, absolute_sigma) -> CalibrationResult:  # fmt: skip
     cov, note = covariance(jac, r, absolute_sigma)
     fidelity, surfaces = model.fidelity, model.surfaces
     if code not in (STATUS_START, STATUS_RANGE) and np.all(np.isfinite(theta)):
@@ -570,6 +593,7 @@ def _result(names, theta, theta0, jac, r, r0, loss, measured, w, status, steps, 
         status=int(code),
         note=note,
         detail=detail,
+        failed_points=tuple(int(i) for i in failed),
         fidelity=fidelity,
         surfaces=surfaces,
     )
