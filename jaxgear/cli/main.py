@@ -12,7 +12,7 @@ import importlib
 import sys
 
 # Subcommand modules, in the order shown by --help.
-COMMANDS = ("run", "sweep", "figures", "mesh", "ehl", "optimise", "pareto")
+COMMANDS = ("run", "sweep", "figures", "mesh", "ehl", "optimise", "pareto", "calibrate")
 
 
 class _Parser(argparse.ArgumentParser):
