@@ -8,6 +8,7 @@ import pytest
 
 import jaxgear as jg
 from jaxgear import optimise
+from jaxgear.design import calibrate
 from jaxgear.dynamics import response
 from jaxgear.results import MESSAGES, Status, message, messages
 from jaxgear.tribodynamics import result
@@ -20,7 +21,7 @@ def test_every_code_has_distinct_words():
 
 
 def test_each_result_types_codes_are_codes_of_the_enumeration():
-    for names in (result.STATUS_NAMES, optimise.STATUS_NAMES):
+    for names in (result.STATUS_NAMES, optimise.STATUS_NAMES, calibrate.STATUS_NAMES):
         assert set(names) <= {int(s) for s in Status}
     dynamic = (
         response.STATUS_CONVERGED,
