@@ -19,8 +19,9 @@ Numerics:
   positive (a friction coefficient, a density product, a scale), and in η no step can make one
   negative or zero; steps are relative changes of θ. Values, standard errors and covariance are
   reported in the natural units of θ.
-- **Levenberg-Marquardt** (``optimistix.LevenbergMarquardt``, QR linear solves), the model vmapped
-  over the points in one traced function; the Jacobian in forward mode through jaxgear's implicit
+- **Levenberg-Marquardt** (``optimistix.LevenbergMarquardt``, QR linear solves), the model over
+  all points in one traced function (vmapped, or mapped on the EHL and tribo-dynamic rungs:
+  ``batches_points``); the Jacobian in forward mode through jaxgear's implicit
   derivatives of its converged solves (the constants are traced numbers: nothing recompiles between
   steps, and the same two programs serve every calibration of the same shapes).
 - **Failed points are never fitted.** A point whose simulation reports a status other than 0 (a
@@ -81,7 +82,7 @@ STATUS_RANGE = Status.RANGE
 STATUS_NAMES = {
     int(Status.OK): "converged (parameter and residual changes below tolerance)",
     int(Status.MAX_STEPS): "step cap reached before the tolerances",
-    int(Status.SIMULATION): "the simulation failed at the fitted constants",
+    int(Status.SIMULATION): "the simulation failed at or next to the fitted constants",
     int(Status.START): "the simulation failed at the start values; nothing fitted",
     int(Status.NON_FINITE): "non-finite residual or Jacobian at the fitted constants",
     int(Status.RANGE): MESSAGES[Status.RANGE],
@@ -195,11 +196,21 @@ def substitute(fidelity: Fidelity, surfaces: Surfaces, names, theta):
     return fidelity, surfaces
 
 
+def batches_points(fidelity: Fidelity) -> bool:
+    """Whether ``PowerLossModel`` vmaps its points (True) or maps them one after another
+    (``lax.map``): vmapped on the quasi-static formula rungs; mapped where the contacts are EHL
+    solves or the dynamics are tribo-dynamic, whose lazy branches (``_solvers.lazy_cond``) do not
+    support forward-mode differentiation of a vmap (jvp of a vmapped transient EHL passage fails
+    while tracing), which is what the Levenberg-Marquardt linearisation takes. On a CPU the
+    points of those rungs run one after another either way."""
+    return fidelity.dynamics == "quasi_static" and not fidelity.uses_ehl
+
+
 class PowerLossModel(eqx.Module):
     """Φ̄ at each calibration point as a function of the parameters θ (natural units).
 
     Call with θ [p]; returns (Φ̄ W [n], simulation status [n]). The points are one
-    OperatingPoint whose fields are arrays [n], vmapped over."""
+    OperatingPoint whose fields are arrays [n], vmapped over, or mapped (``batches_points``)."""
 
     pair: object
     lubricant: object
@@ -215,7 +226,9 @@ class PowerLossModel(eqx.Module):
             result = _simulate_point(self.pair, self.lubricant, surfaces, op, fidelity)
             return result.power_loss, result.status
 
-        return jax.vmap(one)(self.points)
+        if batches_points(self.fidelity):
+            return jax.vmap(one)(self.points)
+        return jax.lax.map(one, self.points)
 
 
 @eqx.filter_jit
