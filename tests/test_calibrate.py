@@ -143,9 +143,12 @@ def test_noisy_fit_lies_within_its_standard_errors_and_they_match_a_monte_carlo(
     assert np.all((0.6 < reported / se_linear) & (reported / se_linear < 1.5))
 
 
-def test_roughness_scale_with_as_many_points_as_parameters():
+def test_roughness_scale_with_as_many_points_as_parameters(monkeypatch):
     """The roughness scale alone from one point: recovered, and n = p leaves the standard errors
-    undefined (NaN, with the reason), unless the weights are known uncertainties."""
+    undefined (NaN, with the reason), unless the weights are known uncertainties. The points are
+    mapped one after another (``lax.map``), the path of the EHL and tribo-dynamic rungs, here on
+    the cheap rung (a parameter no other test fits: its own compiled programs)."""
+    monkeypatch.setattr(calibrate_module, "batches_points", lambda fidelity: False)
     point = [POINTS[1]]
     truth = 1.3
     data = _losses(FID, point, surfaces=eqx.tree_at(lambda s: s.scale, SURF, jnp.asarray(truth)))
@@ -318,3 +321,23 @@ def test_command_line_bad_data_exits_2_with_one_line(tmp_path, capsys, text, arg
     assert code == 2
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert re.search(match, err), err
+
+
+@pytest.mark.slow
+def test_recovers_boundary_friction_on_the_tribo_dynamic_rung():
+    """The tribo-dynamic fixed point (points mapped, second pass traced): μb from three speeds
+    with a stable periodic orbit (the calibrated pair's unstable bands at this rung: 775-825,
+    1925-1975, 3375-3550, 3750-4050 rpm). The fixed point converged to 1e-10 so that Φ̄ is
+    reproducible far below the tolerance; noise-free data, so 1e-5 relative (the fixed point and
+    the orbit's Newton leave ~1e-9 in Φ̄, amplified by the inverse slope of Φ̄ in μb, ~1)."""
+    fid = jg.Fidelity.fast(fixed_point_tolerance=1e-10)
+    points = [
+        jg.OperatingPoint(torque=t, speed_rpm=s, inlet_temperature=363.15)
+        for t, s in ((500.0, 1200.0), (700.0, 2500.0), (900.0, 3000.0))
+    ]
+    data = _losses(fid.with_constants(boundary_friction=0.12), points)
+    fit = jg.calibrate(PAIR, LUB, SURF, fid, points, data, ("boundary_friction",))
+    assert fit.converged, fit.message
+    assert fit.values["boundary_friction"] == pytest.approx(0.12, rel=1e-5)
+    se = fit.standard_errors["boundary_friction"]
+    assert np.isfinite(se) and se < 1e-4
