@@ -18,6 +18,7 @@ Run: ``python benchmarks/calibration.py [--nodes 257] [--fit asperity_density_pr
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import jax
@@ -80,7 +81,8 @@ def main(argv=None) -> None:
         f"90 °C, to the paper's quasi-static Φ̄ at A, B, D, E (nominal speeds); relative residuals, "
         f"unit weights, rtol {args.rtol:g}, atol {args.atol:g}. Wall time of the fit (compilation "
         f"included): {wall:.0f} s, {fit.steps} Levenberg-Marquardt steps; status {fit.status}: "
-        f"{fit.message}.",
+        f"{fit.message}. Load average (1 min) after the fit: {os.getloadavg()[0]:.1f} on "
+        f"{os.cpu_count()} cores.",
         "",
         "| parameter | start | fitted | standard error |",
         "|---|---|---|---|",
@@ -117,8 +119,8 @@ def _checks(pair, lub, surf, fit, nodes: int, tribo_dynamic: bool) -> list[str]:
     qs_fid = fit.fidelity.replace(n_nodes=nodes)
     td_fid = qs_fid.replace(dynamics="tribo_dynamic")
     rows = [
-        f"Checks (not fitted): the fitted constants on {nodes} nodes per contact; time: both "
-        "models of the point, the first row with compilation.",
+        f"Checks (not fitted): the fitted constants on {nodes} nodes per contact; time: the "
+        "point's simulations, the first row with compilation.",
         "",
         "| point | rpm | Φ̄ QS (W) | paper QS | QS/paper | Φ̄ TD (W) | paper TD | TD vs QS | "
         "paper (R3) | status | time (s) |",

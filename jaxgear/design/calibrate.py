@@ -54,6 +54,7 @@ import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
 
+from .._inputs import canonical, validate
 from .._validation import check_instance, is_concrete
 from ..fidelity import Fidelity
 from ..fidelity.ladder import CONSTANTS
@@ -473,6 +474,10 @@ def calibrate(
         ),
         fidelity,
     )
+    # float leaves as float64 arrays (a Python float put in by eqx.tree_at would be a static leaf:
+    # a recompilation per value), checked as their constructors would (as simulate does)
+    pair, lubricant, surfaces, fidelity = canonical((pair, lubricant, surfaces, fidelity))
+    validate((pair, lubricant, surfaces, fidelity))
     measured = _per_point("measured_power_loss", measured_power_loss, n)
     w = _per_point("weights", weights, n, default=1.0)
     if n < p:
