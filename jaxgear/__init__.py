@@ -26,6 +26,8 @@ from .material import Material as Material
 __version__ = "0.1.0"
 from .design.calibrate import CalibrationResult as CalibrationResult
 from .design.calibrate import calibrate as calibrate
+from .design.sensitivity import SensitivityReport as SensitivityReport
+from .design.sensitivity import sensitivity as sensitivity
 from .dynamics import DynamicResponse as DynamicResponse
 from .dynamics import DynamicsOptions as DynamicsOptions
 from .dynamics import MeshInterface as MeshInterface
