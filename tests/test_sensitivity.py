@@ -19,6 +19,7 @@ import pytest
 
 import jaxgear as jg
 import jaxgear.design.sensitivity as sens
+from jaxgear.cli.main import main as cli_main
 
 PAIR = jg.presets.li2015_pair_calibrated()
 LUB, SURF = jg.presets.mil_l_23699(), jg.presets.ground()
@@ -249,6 +250,50 @@ def test_files_and_tornado(report, tmp_path):
     assert finite == sorted(finite, reverse=True)
     path = sens.plot_tornado(report, "power_loss", tmp_path / "t.png", top=8)
     assert path.stat().st_size > 5000
+
+
+def test_cli_writes_the_report_and_its_figures(report, tmp_path, capsys):
+    code = cli_main(
+        [
+            "sensitivity",
+            "--fidelity",
+            "quasi_static",
+            "--torque",
+            "650",
+            "--speed",
+            "2500",
+            "--outputs",
+            ",".join(OUTPUTS),
+            "--out",
+            str(tmp_path),
+        ]
+    )
+    printed = capsys.readouterr().out
+    assert code == 0
+    for name in ("sensitivity.csv", "sensitivity.json", *(f"tornado_{o}.png" for o in OUTPUTS)):
+        assert (tmp_path / name).stat().st_size > 0, name
+    data = json.loads((tmp_path / "sensitivity.json").read_text())
+    assert data["inputs"]["op.torque"]["value"] == 650.0
+    assert "op.torque" in data["derivatives"]["efficiency"]
+    assert "efficiency" in printed and printed.count("\n") < 80
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["--outputs", "efficency"], "unknown output 'efficency'"),
+        (["--torque", "-5"], "torque"),
+        (["--fidelity", "auto"], "invalid choice"),
+    ],
+)
+def test_cli_rejects_bad_input_with_exit_code_2(tmp_path, capsys, argv, words):
+    try:
+        code = cli_main(["sensitivity", *argv, "--out", str(tmp_path)])
+    except SystemExit as stop:  # argparse's own errors
+        code = stop.code
+    err = capsys.readouterr().err
+    assert code == 2
+    assert words in err and "Traceback" not in err and err.count("\n") == 1, err
 
 
 @pytest.mark.slow

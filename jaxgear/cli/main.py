@@ -12,7 +12,9 @@ import importlib
 import sys
 
 # Subcommand modules, in the order shown by --help.
-COMMANDS = ("run", "sweep", "figures", "mesh", "ehl", "optimise", "pareto", "calibrate")
+COMMANDS = (
+    "run", "sweep", "figures", "mesh", "ehl", "optimise", "pareto", "sensitivity", "calibrate",
+)  # fmt: skip
 
 
 class _Parser(argparse.ArgumentParser):
