@@ -27,7 +27,9 @@ field as the OperatingPoint holds it, in rpm.
 
 Cost: one program is compiled per fidelity and tuple of outputs, and it runs one forward solve and
 one reverse (vector-Jacobian) pass per output, so the derivatives with respect to all inputs cost
-about K + 1 forward solves for K outputs; a new input value reuses the program.
+about K + 1 forward solves for K outputs; a new input value reuses the program. As ``simulate``,
+it holds the first pass only; the second pass (the attractor where no stable periodic orbit exists,
+the back flanks' loss where the orbit strikes them) is compiled only for a point that needs it.
 """
 
 from __future__ import annotations
@@ -49,7 +51,14 @@ from .._validation import check_non_negative, is_concrete
 from ..fidelity import Fidelity
 from ..gear.geometry import gear_geometry
 from ..results import Status, message
-from ..tribodynamics import check_inputs, simulate_with_state
+from ..tribodynamics import (
+    STATUS_PENDING,
+    check_inputs,
+    first_pass,
+    needs_second_pass,
+    simulate_with_state,
+)
+from ..tribodynamics.passes import _finish_jit
 from . import metrics
 
 #: The outputs a report can differentiate → unit: every scalar of ``metrics.SCALARS`` and the peak
@@ -119,13 +128,16 @@ _NO_DERIVATIVE = "no derivative exists at this point"
 
 
 def derivative_unit(output_unit: str, input_unit: str) -> str:
-    """The unit of ∂y/∂x from the units of y and x ("-": dimensionless), e.g. "W/m", "1/K"."""
+    """The unit of ∂y/∂x from the units of y and x ("-": dimensionless), e.g. "W/m", "1/K";
+    "-" where they are the same unit."""
 
     def wrapped(unit):
         return unit if all(c.isalnum() or c == "^" for c in unit) else f"({unit})"
 
     if input_unit == "-":
         return output_unit
+    if input_unit == output_unit:
+        return "-"
     numerator = "1" if output_unit == "-" else output_unit
     return f"{numerator}/{wrapped(input_unit)}"
 
@@ -217,14 +229,12 @@ class SensitivityReport:
 
     def _indices(self, output: str, input: str) -> tuple[int, int]:
         i = self._output_index(output)
-        if input not in self.input_names:
-            raise ValueError(
-                f"input {input!r} is not in this report; its inputs: {', '.join(self.input_names)}"
-            )
-        return i, self.input_names.index(input)
+        name = resolve_input(input, self.input_names, "in this report")
+        return i, self.input_names.index(name)
 
     def derivative(self, output: str, input: str) -> float:
-        """∂output/∂input in ``derivative_unit(output unit, input unit)`` (NaN unless converged)."""
+        """∂output/∂input in ``derivative_unit(output unit, input unit)`` (NaN unless converged);
+        ``input`` a full name or one without its group where unambiguous ("torque")."""
         i, j = self._indices(output, input)
         return float(self.derivatives[i, j])
 
@@ -404,20 +414,30 @@ def _outputs_of(result, pair, outputs):
     return jnp.stack([metrics.peak(n, metrics.quantity(n, result, pair)) for n in outputs])
 
 
-def _values_and_derivatives(params, rest, outputs: tuple[str, ...]):
-    """(outputs [K], status, ∂outputs/∂params: params' tree with a leading axis K): one forward
-    solve, then one vector-Jacobian product per unit cotangent, in a loop of the same program."""
+def _values_and_derivatives(params, rest, outputs: tuple[str, ...], second_pass: bool = False):
+    """(outputs [K], status, ∂outputs/∂params: params' tree with a leading axis K, and the first
+    pass's (Pending, whether the point needs the second pass)): one forward solve, then one
+    vector-Jacobian product per unit cotangent, in a loop of the same program.
+
+    ``second_pass`` False: the first pass only, as ``simulate`` compiles it (where the point needs
+    the second pass, its derivatives are NaN and the caller goes on); True: both passes
+    (``simulate_with_state``), for a periodic orbit that strikes the back flanks."""
 
     def forward(p):
         pair, lubricant, surfaces, op, fidelity = eqx.combine(p, rest)
-        result, _ = simulate_with_state(pair, lubricant, surfaces, op, fidelity)
-        return _outputs_of(result, pair, outputs), result.status
+        if second_pass:
+            result, _ = simulate_with_state(pair, lubricant, surfaces, op, fidelity)
+            pending, later = None, jnp.asarray(False)
+        else:
+            result, _, pending = first_pass(pair, lubricant, surfaces, op, fidelity)
+            later = needs_second_pass(pending, fidelity)
+        return _outputs_of(result, pair, outputs), (result.status, pending, later)
 
-    values, pullback, status = jax.vjp(forward, params, has_aux=True)
+    values, pullback, (status, pending, later) = jax.vjp(forward, params, has_aux=True)
     # lax.map, not vmap: each reverse pass runs as it would alone (a batched while loop would run
     # every member until the last stops, a batched cond both branches)
     (derivatives,) = jax.lax.map(pullback, jnp.eye(len(outputs), dtype=values.dtype))
-    return values, status, derivatives
+    return values, status, derivatives, (pending, later)
 
 
 _program = eqx.filter_jit(_values_and_derivatives)
@@ -437,16 +457,33 @@ def _check_outputs(outputs) -> tuple[str, ...]:
     return outputs
 
 
+def resolve_input(name: str, names: Sequence[str], where: str = "") -> str:
+    """The full name of the input ``name`` among ``names``: itself, or the one name it ends with
+    after its group (``"torque"`` → ``"op.torque"``, ``"tip_relief.amount[1]"`` →
+    ``"pair.tip_relief.amount[1]"``, ``"boundary_friction"`` → ``"fidelity.boundary_friction"``).
+
+    Raises:
+        ValueError: an unknown or ambiguous name, naming it and the valid names.
+    """
+    if name in names:
+        return name
+    matches = [n for n in names if n.split(".", 1)[-1] == name]
+    if len(matches) == 1:
+        return matches[0]
+    place = f" {where}" if where else ""
+    if matches:
+        raise ValueError(f"input {name!r} is ambiguous{place}; it may be: {', '.join(matches)}")
+    raise ValueError(f"unknown input {name!r}{place}; valid names: {', '.join(names)}")
+
+
 def _selected(entries: list[_Input], inputs) -> list[_Input]:
     if inputs is None:
         return entries
     if isinstance(inputs, str):
         inputs = (inputs,)
     by_name = {e.name: e for e in entries}
-    for name in inputs:
-        if name not in by_name:
-            raise ValueError(f"unknown input {name!r}; valid names: {', '.join(by_name)}")
-    return [by_name[name] for name in dict.fromkeys(inputs)]
+    chosen = [resolve_input(name, list(by_name)) for name in inputs]
+    return [by_name[name] for name in dict.fromkeys(chosen)]
 
 
 def sensitivity(
@@ -471,7 +508,8 @@ def sensitivity(
             ``metrics.SCALARS``, and ``hertz_pressure``/``flash_temperature`` as the peak of their
             field over the mesh cycle (a peak's derivative is that of the entry where it is
             reached).
-        inputs: the names to report (default every input; ``input_names`` lists them). The
+        inputs: the names to report (default every input; ``input_names`` lists them; a name
+            may leave out its group where that is unambiguous: "torque" for "op.torque"). The
             program is the same whichever are chosen: reverse mode gives all at once.
 
     Returns:
@@ -500,7 +538,16 @@ def sensitivity(
 
     params, rest = _differentiated((pair, lubricant, surfaces, op, fidelity))
     chosen = _selected(_enumerate(params, pair.overrides), inputs)
-    values, status, grads = _program(params, rest, outputs)
+    values, status, grads, (pending, later) = _program(params, rest, outputs)
+    if bool(later):
+        # as simulate: what few points need is compiled only where it is reached
+        if int(status) == STATUS_PENDING:
+            # a periodic orbit striking the back flanks: their loss and its derivatives
+            values, status, grads, _ = _program(params, rest, outputs, True)
+        else:
+            # no stable periodic orbit: the values are means over the attractor; no derivative
+            result = _finish_jit(pair, lubricant, surfaces, op, fidelity, pending)
+            values, status = _outputs_of(result, pair, outputs), result.status
     leaves = jax.tree_util.tree_leaves(params)
     grad_leaves = [np.asarray(g) for g in jax.tree_util.tree_leaves(grads)]
     x, d = [], []
