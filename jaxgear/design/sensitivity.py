@@ -159,9 +159,9 @@ class SensitivityReport:
         message: the status in words.
 
     ``elasticity`` is d ln y/d ln x = (x/y) ∂y/∂x, dimensionless: the relative change of the output
-    per relative change of the input. It is NaN where x = 0 (an input at zero, such as a backlash of
-    zero or a contact constant a rung does not use, has no relative change: read its derivative)
-    or y = 0.
+    per relative change of the input. It is NaN where x = 0 (an input at zero, such as a zero
+    profile shift, offset or mesh damping ratio, has no relative change: read its derivative) or
+    y = 0.
     """
 
     def __init__(
