@@ -125,8 +125,11 @@ def main():
             f"{old['loss']:.0f} ({old['loss_sliding']:.0f} + {old['loss_rolling']:.0f}) → "
             f"{new['loss']:.0f} ({new['loss_sliding']:.0f} + {new['loss_rolling']:.0f}) |"
         )
-    write_section("mean_plane", "## The statistical film on the mean plane "
-                  "(`benchmarks/mean_plane.py`)\n\n" + "\n".join(lines))
+    write_section(
+        "mean_plane",
+        "## The statistical film on the mean plane "
+        "(`benchmarks/mean_plane.py`)\n\n" + "\n".join(lines),
+    )
     print("\n".join(lines))
 
 

@@ -39,7 +39,8 @@ fid = jg.Fidelity.fast()
 """
 
 PROBES = {
-    "optimise": COMMON + r"""
+    "optimise": COMMON
+    + r"""
 t0 = time.perf_counter()
 r = jg.optimise_tip_relief(pair, lub, surf, op, speeds_rpm=[1000.0, 2000.0, 3000.0], fidelity=fid,
                            constraints={"dte_rms": 1.5e-6})
@@ -49,7 +50,8 @@ print(json.dumps({"wall": wall, "status": r.message, "evaluations": r.evaluation
                   "efficiency": r.objective_value, "efficiency_start": r.objective_start,
                   "dte_um": (np.asarray(r.values["dte_rms"]) * 1e6).tolist()}))
 """,
-    "pareto": COMMON + r"""
+    "pareto": COMMON
+    + r"""
 from jaxgear.design.pareto import pareto_front
 t0 = time.perf_counter()
 f = pareto_front(pair, lub, surf, op, speeds_rpm=[1000.0, 2000.0, 3000.0], fidelity=fid,
@@ -60,7 +62,8 @@ print(json.dumps({"wall": wall, "ok": int((f.status == 0).sum()), "efficient": i
                   "dte_um": (f.trade_values * 1e6).tolist(),
                   "efficiency": f.objective_values.tolist()}))
 """,
-    "sensitivity": COMMON + r"""
+    "sensitivity": COMMON
+    + r"""
 op = jg.OperatingPoint(torque=700.0, speed_rpm=2500.0, inlet_temperature=363.15)
 from jaxgear.tribodynamics.passes import simulate_with_state
 fwd = jax.jit(lambda p, o: simulate_with_state(p, lub, surf, o, fid)[0].efficiency)

@@ -26,8 +26,12 @@ from .material import Material as Material
 __version__ = "0.1.0"
 from .design.calibrate import CalibrationResult as CalibrationResult
 from .design.calibrate import calibrate as calibrate
+from .design.pareto import ParetoFront as ParetoFront
+from .design.pareto import pareto_front as pareto_front
 from .design.sensitivity import SensitivityReport as SensitivityReport
 from .design.sensitivity import sensitivity as sensitivity
+from .design.tip_relief import DesignResult as DesignResult
+from .design.tip_relief import optimise_tip_relief as optimise_tip_relief
 from .dynamics import DynamicResponse as DynamicResponse
 from .dynamics import DynamicsOptions as DynamicsOptions
 from .dynamics import MeshInterface as MeshInterface
@@ -55,10 +59,6 @@ from .operating import OperatingPoint as OperatingPoint
 from .optimise import OptimisationResult as OptimisationResult
 from .optimise import optimise as optimise_bounded
 from .optimise import optimise_roughness_scale as optimise_roughness_scale
-from .design.pareto import ParetoFront as ParetoFront
-from .design.pareto import pareto_front as pareto_front
-from .design.tip_relief import DesignResult as DesignResult
-from .design.tip_relief import optimise_tip_relief as optimise_tip_relief
 from .optimise import optimise_torque as optimise_torque
 from .results import Status as Status
 from .sweep import SweepResult as SweepResult

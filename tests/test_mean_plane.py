@@ -122,10 +122,24 @@ def test_full_film_limit_is_the_smooth_film():
     smooth = jg.solve_ehl(c, LUB, SMOOTH)
     assert bool(smooth.converged)
     bounds = {
-        1.0: dict(power_loss=5e-3, power_loss_sliding=1e-3, friction_sliding=1e-3,
-                  power_loss_rolling=0.05, friction_rolling=0.05, h_central=0.05, h_min=0.05),
-        0.3: dict(power_loss=1e-3, power_loss_sliding=1e-3, friction_sliding=1e-3,
-                  power_loss_rolling=1e-3, friction_rolling=1e-3, h_central=1e-3, h_min=1e-3),
+        1.0: dict(
+            power_loss=5e-3,
+            power_loss_sliding=1e-3,
+            friction_sliding=1e-3,
+            power_loss_rolling=0.05,
+            friction_rolling=0.05,
+            h_central=0.05,
+            h_min=0.05,
+        ),
+        0.3: dict(
+            power_loss=1e-3,
+            power_loss_sliding=1e-3,
+            friction_sliding=1e-3,
+            power_loss_rolling=1e-3,
+            friction_rolling=1e-3,
+            h_central=1e-3,
+            h_min=1e-3,
+        ),
     }
     for scale, fields in bounds.items():
         surf = polished(scale)
@@ -164,7 +178,11 @@ def _dry_rough_contact(contact, sigma, model, x):
     asperities Greenwood-Tripp's: p = K′E′F_{5/2}(d/σ), d = d0 + x²/2R + v(p), v the elastic
     half-plane's displacement −(4/πE′)∫ p(s) ln|x − s| ds (up to a constant in d0), ∫ p dx = w.
     Piecewise-constant pressure panels on ``x``, solved by scipy's root finder (hybr)."""
-    r, w, e = (float(contact.reduced_radius), float(contact.load_per_width), float(contact.e_reduced))
+    r, w, e = (
+        float(contact.reduced_radius),
+        float(contact.load_per_width),
+        float(contact.e_reduced),
+    )
     k = greenwood_tripp_constant(model.asperity_density_product, model.asperity_slope_ratio) * e
     dx = x[1] - x[0]
 
@@ -219,8 +237,10 @@ def test_rolling_speed_to_zero_tends_to_the_dry_rough_contact():
     x = np.asarray(sols[-1].x)
     dry = _dry_rough_contact(c_slow, sigma, STAT, x)
     ph = float(sols[-1].hertz_pressure)
-    gaps = [float(np.max(np.abs(np.interp(x, np.asarray(s.x), np.asarray(s.p)) - dry))) / ph
-            for s in sols]
+    gaps = [
+        float(np.max(np.abs(np.interp(x, np.asarray(s.x), np.asarray(s.p)) - dry))) / ph
+        for s in sols
+    ]
     # the difference shrinks as the speed falls (measured 0.15, 0.096, 0.006 ph at 30, 3, 0.3 rpm)
     # and at 0.3 rpm the film's pressure is the dry contact's within 3 % of ph (measured 0.6 %: the
     # fluid still carries 0.85 % of the load; the two discretisations differ by O(Δx²))
@@ -238,9 +258,7 @@ def _loss_and_share(theta, rpm, surfaces):
     """(power loss W/m, asperity load share, converged) of the statistical film at the pitch
     contact, θ = (roughness scale, nβσ, load per width N/m)."""
     c = gear_contact(rpm=1.0)
-    c = eqx.tree_at(
-        lambda k: (k.load_per_width, k.u1, k.u2), c, (theta[2], c.u1 * rpm, c.u2 * rpm)
-    )
+    c = eqx.tree_at(lambda k: (k.load_per_width, k.u1, k.u2), c, (theta[2], c.u1 * rpm, c.u2 * rpm))
     surf = eqx.tree_at(lambda s: s.scale, surfaces, theta[0])
     model = eqx.tree_at(lambda m: m.asperity_density_product, STAT, theta[1])
     sol = jg.solve_ehl(c, LUB, model, surf)
@@ -249,7 +267,9 @@ def _loss_and_share(theta, rpm, surfaces):
 
 _values = eqx.filter_jit(_loss_and_share)
 _tangents = eqx.filter_jit(
-    lambda theta, e, rpm, surfaces: jax.jvp(lambda t: _loss_and_share(t, rpm, surfaces), (theta,), (e,))
+    lambda theta, e, rpm, surfaces: jax.jvp(
+        lambda t: _loss_and_share(t, rpm, surfaces), (theta,), (e,)
+    )
 )
 
 

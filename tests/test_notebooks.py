@@ -11,7 +11,11 @@ ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
 DEFAULT = ("quickstart.ipynb",)
 # run below at reduced resolution (their cheap siblings: tests/test_design_optimise.py)
-OWN_TEST = ("paper_reproduction.ipynb", "tip_relief_optimisation.ipynb", "design_optimisation.ipynb")
+OWN_TEST = (
+    "paper_reproduction.ipynb",
+    "tip_relief_optimisation.ipynb",
+    "design_optimisation.ipynb",
+)
 
 
 def _execute(name, monkeypatch, timeout=900):

@@ -113,7 +113,9 @@ def separation_of_gap(h, sigma):
         return normal_cdf(lam) / (lam * normal_cdf(lam) + normal_pdf(lam))
 
     # start: the film itself where it is thick; the Gaussian tail's λ where it is thin
-    thin = -jnp.sqrt(2.0 * jnp.maximum(-jnp.log(jnp.minimum(g, 0.3) * math.sqrt(2.0 * math.pi)), 0.0))
+    thin = -jnp.sqrt(
+        2.0 * jnp.maximum(-jnp.log(jnp.minimum(g, 0.3) * math.sqrt(2.0 * math.pi)), 0.0)
+    )
     lam = jax.lax.stop_gradient(jnp.where(g > 0.4, g, thin))
 
     def step(_, lam):
