@@ -58,6 +58,16 @@ def test_tip_relief_optimisation_notebook(monkeypatch):
 
 
 @pytest.mark.slow
+def test_design_optimisation_notebook(monkeypatch):
+    # reduced: one torque, a 4-point front on a 3 x 3 grid; the constrained optimiser, the front's
+    # batch program and the sensitivity report compile in the kernel
+    monkeypatch.setenv("JAXGEAR_NOTEBOOK_QUICK", "1")
+    text = _execute("design_optimisation.ipynb", monkeypatch, timeout=1800)
+    assert "relief:" in text and "DTE <=" in text and "elasticities" in text
+    assert "checks passed" in text
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "name",
     sorted(p.name for p in NOTEBOOKS.glob("*.ipynb") if p.name not in DEFAULT + OWN_TEST),
