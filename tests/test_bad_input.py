@@ -382,9 +382,12 @@ def test_sweep(model, kwargs, field, value):
 @pytest.mark.parametrize(
     "function, kwargs, field, value",
     [
-        ("optimise_tip_relief", dict(steps=-1), "steps", "-1"),
-        ("optimise_tip_relief", dict(learning_rate=NAN), "learning_rate", "nan"),
+        ("optimise_tip_relief", dict(max_evaluations=-1), "max_evaluations", "-1"),
+        ("optimise_tip_relief", dict(max_evaluations=2.5), "max_evaluations", "2.5"),
+        ("optimise_tip_relief", dict(ctol=NAN), "ctol", "nan"),
         ("optimise_tip_relief", dict(gtol=0.0), "gtol", "0.0"),
+        ("optimise_tip_relief", dict(objective="noise"), "objective", "'noise'"),
+        ("optimise_tip_relief", dict(constraints={"dte_rms": NAN}), "dte_rms", "nan"),
         ("optimise_tip_relief", dict(speeds_rpm=[NAN]), "speeds_rpm", "nan"),
         ("optimise_tip_relief", dict(shape="cubic"), "shape", "'cubic'"),
         ("optimise_tip_relief", dict(bounds={"amount": (-1e-6, 1e-5)}), "amount", "-1e-06"),
@@ -398,7 +401,8 @@ def test_sweep(model, kwargs, field, value):
     ],
 )
 def test_optimise(model, function, kwargs, field, value):
-    kwargs = {"fidelity": model["fid"], "steps": 1, **kwargs}
+    budget = {"max_evaluations": 1} if function == "optimise_tip_relief" else {"steps": 1}
+    kwargs = {"fidelity": model["fid"], **budget, **kwargs}
     args = (model["pair"], model["lub"], model["surf"], model["op"])
     expect_rejection(lambda: getattr(jg, function)(*args, **kwargs), field, value)
 

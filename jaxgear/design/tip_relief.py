@@ -515,6 +515,10 @@ def optimise_tip_relief(
         ``failed_points`` naming them; nothing is averaged over them.
     """
     kwargs = dict(ctol=ctol, gtol=gtol, max_evaluations=max_evaluations)
+    if isinstance(max_evaluations, bool) or not isinstance(max_evaluations, int | np.integer):
+        raise ValueError(
+            f"max_evaluations = {max_evaluations!r} is out of range; valid range: integer >= 1"
+        )
     for name, value in kwargs.items():
         if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
             raise ValueError(f"{name} = {value!r} is out of range; valid range: (0, inf)")
