@@ -24,15 +24,19 @@ def _join(t):
     return jnp.concatenate([t["force"], t["orbit"], t["dte"]])
 
 
-def _problem(rho, seed=0, rank=None):
+def _problem(rho, seed=0, rank=None, output_dte=False):
     """A = D (I − J) D⁻¹ on a pytree of leaves with magnitudes SCALES (D), J of spectral radius rho
-    (or of rank ``rank``); the root has the leaves' magnitudes, as the fixed point's does."""
+    (or of rank ``rank``); the root has the leaves' magnitudes, as the fixed point's does.
+    ``output_dte``: no leaf depends on the DTE leaf (J's columns of it zero), as no part of the
+    fixed-point map reads the outputs its state carries."""
     rng = np.random.default_rng(seed)
     n = sum(SIZES)
     if rank is None:
         j = rng.normal(size=(n, n))
     else:
         j = rng.normal(size=(n, rank)) @ rng.normal(size=(rank, n))
+    if output_dte:
+        j[:, SIZES[0] + SIZES[1] :] = 0.0
     j *= rho / np.max(np.abs(np.linalg.eigvals(j)))
     d = np.concatenate([np.full(s, c) for s, c in zip(SIZES, SCALES)])
     a = np.diag(d) @ (np.eye(n) - j) @ np.diag(1.0 / d)
@@ -118,3 +122,47 @@ def test_zero_right_hand_side_and_vmap_equal_loop():
     batched = jax.jit(jax.vmap(one))(bs)
     for k in range(3):
         assert np.allclose(np.asarray(batched[k]), np.asarray(jax.jit(one)(bs[k])), rtol=1e-10)
+
+
+def _leafwise_error(x, exact):
+    """Largest error of each leaf relative to that leaf's largest exact entry."""
+    x, exact = _split(np.asarray(x)), _split(exact)
+    return {k: np.max(np.abs(x[k] - exact[k])) / np.max(np.abs(exact[k])) for k in exact}
+
+
+@pytest.mark.parametrize("rho", [0.5, 0.95])
+def test_transposed_solve_scales_cotangents_by_inverse_magnitudes(rho):
+    # reverse mode's system Aᵀ λ = g: the unknowns are cotangents, of the inverse units of the
+    # root's leaves, and g is the cotangent of one output in metres (the DTE leaf alone, 1/1e-6),
+    # an output that no leaf depends on. Scaled by the root's magnitudes, the residual on the
+    # other leaves weighs (1e-6 / their magnitude)² of the DTE leaf's, and the solve stops with
+    # them unconverged; by their inverses every leaf is solved to its own scale: the error of each
+    # leaf relative to its size is at most the tolerance 1e-10 times the condition number of
+    # I − J (as above), so 1e-8
+    op, a, _, d = _problem(rho, seed=5, output_dte=True)
+    rng = np.random.default_rng(6)
+    g = np.zeros(sum(SIZES))
+    g[SIZES[0] + SIZES[1] :] = rng.normal(size=SIZES[2]) / SCALES[2]
+    exact = np.linalg.solve(a.T, g)
+    solver = EarlyExitGMRES(rtol=1e-10, atol=0.0)
+    root = op.x
+
+    def transposed(g, flag):
+        options = {"scale_point": root, "transposed": flag}
+        sol = lx.linear_solve(op.T, _split(g), solver, options=options, throw=False)
+        return _join(sol.value)
+
+    errors = _leafwise_error(transposed(jnp.asarray(g), True), exact)
+    assert max(errors.values()) < 1e-8, errors
+    # the tangents' scaling leaves the other leaves far off (the defect this option fixes)
+    wrong = _leafwise_error(transposed(jnp.asarray(g), False), exact)
+    assert min(wrong["force"], wrong["orbit"]) > 1e-3, wrong
+
+    # lineax's own transpose of the solve (the reverse mode of linear_solve): the solver's
+    # ``transpose`` inverts the scales likewise
+    def solve(b):
+        return _join(lx.linear_solve(op, _split(b), solver).value)
+
+    _, pullback = jax.vjp(solve, jnp.zeros(sum(SIZES)))
+    errors = _leafwise_error(jax.jit(pullback)(jnp.asarray(g))[0], exact)
+    assert max(errors.values()) < 1e-8, errors

@@ -362,18 +362,17 @@ def test_tribo_dynamic_derivatives_match_central_differences_and_status_6_has_no
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="reverse mode of the tribo-dynamic DTE RMS differs from its forward mode and central "
-    "differences (relief amount: -0.069783 against -0.069579 m/m, 0.3 %; torque 0.06 %), "
-    "jax.grad of simulate's dte_rms alike: a defect of the model's reverse rules, not of the report",
-)
-def test_tribo_dynamic_dte_derivative_matches_central_differences(tribo_report, uncounted):
-    name, get, element, rel = CHECKED[3]  # the relief amount of gear 1
+@pytest.mark.parametrize("index", [0, 3], ids=[CHECKED[0][0], CHECKED[3][0]])
+def test_tribo_dynamic_dte_derivative_matches_central_differences(tribo_report, uncounted, index):
+    # the DTE RMS, a fixed-point output in metres beside leaves in newtons: reverse mode once
+    # stopped its transposed implicit solve with those leaves unconverged (0.3 % off on the
+    # relief amount, 0.06 % on the torque). Central differences: the relief's measured stable to
+    # 1e-7 relative over steps of 1e-5 to 1e-2 relative; the torque's step of 1e-4 leaves noise
+    # ~1e-6 relative (y's ~1e-10); 2e-5 is well below either defect
+    name, get, element, rel = CHECKED[index]
     x, fd = _tribo_central_differences(name, get, element, rel)
     d = tribo_report.derivative("dte_rms", name)
-    # FD measured stable to 1e-7 relative over steps of 1e-5 to 1e-2 relative
-    assert d == pytest.approx(fd[2], rel=1e-3)
+    assert d == pytest.approx(fd[2], rel=2e-5), (name, d, fd[2])
 
 
 @pytest.mark.slow

@@ -7,8 +7,9 @@ right-hand side. In the coupled model that turns a derivative that does not exis
 I − ∂T/∂x, a NaN input tangent) into a crash of the caller's ``jax.grad``. ``NaNImplicitAdjoint``
 is the same rule with the solve's failure left in its value: with a solver that returns NaN where
 it fails (``EarlyExitGMRES(nan_on_failure=True)``) the tangent is NaN, and the primal result is
-untouched. It transposes as lineax's solve does (the transposed solve is the same solver's), so
-reverse mode works as well as forward mode.
+untouched. It transposes as lineax's solve does (the transposed solve is the same solver's, told
+that its unknowns are cotangents: ``EarlyExitGMRES`` scales them by the root's inverse magnitudes),
+so reverse mode is as accurate as forward mode.
 """
 
 from __future__ import annotations
@@ -80,13 +81,18 @@ def _implicit_jvp(primals, tangents):
     def matvec(v):
         return jax.jvp(lambda r: rewrite_at(r, inputs), (root,), (v,))[1]
 
-    def solve(mv, b):
+    def solve(mv, b, transposed=False):
         # throw=False: a solver that fails says so in its value (EarlyExitGMRES(nan_on_failure=
-        # True) returns NaN); lineax would raise on it, from inside the transformation
+        # True) returns NaN); lineax would raise on it, from inside the transformation.
+        # transposed: the unknowns are cotangents of the root, scaled by its inverse magnitudes
+        # (EarlyExitGMRES); scaled as tangents, the residual on the leaves of large magnitude
+        # counts for almost nothing and reverse mode stops short of forward mode's accuracy.
         operator = lx.FunctionLinearOperator(mv, jax.eval_shape(lambda: b), tags=tags)
-        return lx.linear_solve(
-            operator, b, linear_solver, options={"scale_point": root}, throw=False
-        ).value
+        options = {"scale_point": root, "transposed": transposed}
+        return lx.linear_solve(operator, b, linear_solver, options=options, throw=False).value
+
+    def transpose_solve(mv, b):
+        return solve(mv, b, transposed=True)
 
     _, rhs = jax.jvp(rewrite_of, (diff,), (t_inputs,))
     # Parts of the right-hand side that no input tangent reaches (the state's non-differentiated
@@ -98,8 +104,7 @@ def _implicit_jvp(primals, tangents):
         rhs = jtu.tree_map(lambda leaf: leaf + anchor.astype(leaf.dtype), rhs)
     # custom_linear_solve: JAX transposes it by solving with the transposed operator (the same
     # solver), where lineax's own transpose would raise on a failed solve
-    t_root = jtu.tree_map(
-        lambda x: -x, jax.lax.custom_linear_solve(matvec, rhs, solve, transpose_solve=solve)
-    )
+    solution = jax.lax.custom_linear_solve(matvec, rhs, solve, transpose_solve=transpose_solve)
+    t_root = jtu.tree_map(lambda x: -x, solution)
     t_residual = jax.custom_derivatives.zero_from_primal(residual, symbolic_zeros=True)
     return (root, residual), (t_root, t_residual)

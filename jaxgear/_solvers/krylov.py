@@ -13,6 +13,13 @@ The unknowns are a pytree whose leaves carry different units (N, m/s, m, scaled 
 solve runs in variables scaled per leaf by the magnitude of the root (the point the operator is
 linearised at) — a similarity transform, which changes neither the solution nor the spectrum — so
 the residual norm weighs every leaf by its own size, not by its unit.
+
+The transposed system of reverse mode, (I − ∂T/∂x)ᵀ λ = ḡ, has cotangents for unknowns: their units
+are the inverse of the root's, so they are scaled by the inverse magnitudes (``transpose``, or the
+option ``"transposed"``). Scaled by the root's own magnitudes, the norm would weigh a cotangent leaf
+by the square of its unit's size: the residual on the leaves of large magnitude (forces, in N)
+would count for nothing beside that on the small ones (the DTE, in m), and the solve would stop
+with the former unconverged.
 """
 
 from __future__ import annotations
@@ -39,6 +46,11 @@ def _leaf_scales(x) -> Any:
     return jax.tree_util.tree_map(one, x)
 
 
+def _inverse(scales) -> Any:
+    """The per-leaf scales of the cotangents of a point scaled by ``scales`` (their inverses)."""
+    return jax.tree_util.tree_map(lambda s: 1.0 / s, scales)
+
+
 def _givens(a, b):
     """(c, s) with [c s; −s c]·[a, b] = [r, 0]."""
     r = jnp.hypot(a, b)
@@ -61,6 +73,12 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
         restart: Krylov vectors per cycle (the basis is stored: restart + 1 vectors).
         max_restarts: cycles before giving up.
         nan_on_failure: on failure return NaN as successful (above) instead of a failed result.
+
+    Options (``lx.linear_solve(..., options=...)``):
+        scale_point: the point whose per-leaf magnitudes scale the unknowns (default the
+            operator's linearisation point, else no scaling).
+        transposed: True where the operator is the transpose of one linearised at
+            ``scale_point`` (its unknowns are cotangents): scaled by the inverse magnitudes.
     """
 
     rtol: float
@@ -80,6 +98,8 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
             )
         else:
             scales = _leaf_scales(x)
+            if (options or {}).get("transposed", False):
+                scales = _inverse(scales)
         return lx.linearise(operator), scales
 
     def compute(self, state, vector, options):
@@ -180,8 +200,9 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
         return unravel(flat_d * x), result, {"num_steps": steps, "residual": res, "converged": ok}
 
     def transpose(self, state, options):
+        # the transposed system's unknowns are cotangents: scaled by the inverse magnitudes
         operator, scales = state
-        return (operator.transpose(), scales), options
+        return (operator.transpose(), _inverse(scales)), options
 
     def conj(self, state, options):
         operator, scales = state
