@@ -27,7 +27,7 @@ def quadratic(target, a, b, fail=None):
         ok = fail is None or not fail(u)
         return al.Evaluation(merit, grad, f, g, ok)
 
-    return lambda U, L, R: [one(U[k], L[k], R[k]) for k in range(len(U))]
+    return lambda U, L, R, active=None: [one(U[k], L[k], R[k]) for k in range(len(U))]
 
 
 def solve(target, a, b, u0=(0.1, 0.1), fail=None, **kw):
@@ -83,8 +83,12 @@ def test_lockstep_equals_one_at_a_time():
     alone = [solve(t, [[1.0, 1.0]], [b]) for t, b in cases]
     evaluators = [quadratic(t, [[1.0, 1.0]], [b]) for t, b in cases]
 
-    def batch(U, L, R):
-        return [evaluators[k](U[k : k + 1], L[k : k + 1], R[k : k + 1])[0] for k in range(len(U))]
+    def batch(U, L, R, active):
+        # finished searches need no evaluation
+        return [
+            evaluators[k](U[k : k + 1], L[k : k + 1], R[k : k + 1])[0] if active[k] else None
+            for k in range(len(U))
+        ]
 
     together = al.drive([al.search(np.array([0.1, 0.1]), 1) for _ in cases], batch)
     for a, b in zip(alone, together):

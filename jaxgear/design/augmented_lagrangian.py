@@ -226,18 +226,20 @@ def search(
 
 def drive(
     searches: Sequence[Generator],
-    evaluate: Callable[[np.ndarray, np.ndarray, np.ndarray], Sequence[Evaluation]],
+    evaluate: Callable[..., Sequence[Evaluation | None]],
 ) -> list[Outcome]:
-    """Step searches in lockstep: each round evaluates every unfinished search's trial in one call
-    ``evaluate(u [K, n], λ [K, m], ρ [K])`` (finished ones repeat their last trial) and sends each
-    its evaluation. Returns the outcomes in order."""
+    """Step searches in lockstep: each round evaluates the trials in one call
+    ``evaluate(u [K, n], λ [K, m], ρ [K], active [K])`` and sends each unfinished search
+    (``active``) its evaluation; finished ones repeat their last trial, and ``evaluate`` may skip
+    them (return None there). Returns the outcomes in order."""
     trials = [next(s) for s in searches]
     outcomes: list[Outcome | None] = [None] * len(searches)
     while any(o is None for o in outcomes):
         u = np.stack([t[0] for t in trials])
         lam = np.stack([t[1] for t in trials])
         rho = np.asarray([t[2] for t in trials], dtype=float)
-        evaluations = evaluate(u, lam, rho)
+        active = np.asarray([o is None for o in outcomes])
+        evaluations = evaluate(u, lam, rho, active)
         for k, search_k in enumerate(searches):
             if outcomes[k] is not None:
                 continue

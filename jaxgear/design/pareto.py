@@ -6,7 +6,7 @@ objective with trade ≤ ε_k at every point of the duty cycle (and any further 
 problems share one structure, so they are stepped in lockstep (``augmented_lagrangian.drive``) and
 each round of K trial designs is one batch through the sweep engine (``sweep.engine.run_points``:
 vectorised on an accelerator and shardable over devices, one after the other on a CPU; a failed
-point kept apart from the good ones).
+point kept apart from the good ones; on a CPU only the unfinished problems).
 
 Without given limits, a coarse grid of designs over the bounds (``grid`` per variable, values only)
 sets the range: from just above the smallest trade value a feasible grid design reaches (5 % of the
@@ -241,15 +241,21 @@ def pareto_front(
     rows = {"limits": _limit_rows(limits, problem.constraint_names, trade, limit_map)}
     n_con = constraint_count(problem, jnp.asarray(rows["limits"][0]))
 
-    def batch(u, lam, rho):
+    on_cpu = jax.default_backend() == "cpu"
+
+    def batch(u, lam, rho, rows_k=None):
+        """The merit at each row's trial (``rows_k``: the rows to evaluate, default all)."""
+        rows_k = np.arange(len(u)) if rows_k is None else np.asarray(rows_k)
         inputs = {
-            "u": jnp.asarray(u),
-            "multipliers": jnp.asarray(lam),
-            "rho": jnp.asarray(rho),
-            "limits": jnp.asarray(rows["limits"]),
+            "u": jnp.asarray(u[rows_k]),
+            "multipliers": jnp.asarray(lam[rows_k]),
+            "rho": jnp.asarray(rho[rows_k]),
+            "limits": jnp.asarray(rows["limits"][rows_k]),
         }
+        # on a CPU one problem per chunk, so that finished problems cost nothing and every round
+        # runs the same compiled program; on an accelerator the whole batch at once
         return run_points(batch_point, inputs, args=problem, converged_key=None, label="pareto",
-                          sequential=jax.default_backend() == "cpu")  # fmt: skip
+                          sequential=on_cpu, chunk_size=1 if on_cpu else None)  # fmt: skip
 
     # --- the objective's scale at the first start (shared by every point: one structure) ---
     first = batch(np.stack(starts), np.zeros((k_points, n_con)), np.full(k_points, 1e-12))
@@ -263,10 +269,13 @@ def pareto_front(
     problem = eqx.tree_at(lambda p: (p.reference, p.scale), problem,
                           (jnp.asarray(ref), jnp.asarray(size)))  # fmt: skip
 
-    def evaluate(u, lam, rho):
-        swept = batch(u, lam, rho)
+    def evaluate(u, lam, rho, active):
+        # an accelerator evaluates the whole batch (one shape, one program); a CPU the active rows
+        rows_k = np.nonzero(active)[0] if on_cpu else np.arange(k_points)
+        swept = batch(u, lam, rho, rows_k)
         ok = swept.status == 0
-        return [_row_evaluation(swept.outputs, k, ok[k]) for k in range(k_points)]
+        got = {int(k): _row_evaluation(swept.outputs, i, ok[i]) for i, k in enumerate(rows_k)}
+        return [got.get(k) for k in range(k_points)]
 
     def solve(starts, multipliers):
         searches = [

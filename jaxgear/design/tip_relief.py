@@ -447,7 +447,7 @@ def _solve(problem, names, x0, limits, op, *, ctol, gtol, max_evaluations):
         )  # fmt: skip
         return result_from(problem, outcome, start_out, names, x0, limits, op, start_out)
 
-    def evaluate(u, lam, rho):
+    def evaluate(u, lam, rho, active):
         out = merit_and_gradient(problem, jnp.asarray(u[0]), jnp.asarray(lam[0]),
                                  jnp.asarray(rho[0]), limits_array)  # fmt: skip
         return [evaluation(out)]
