@@ -94,8 +94,14 @@ def probe(name: str) -> dict:
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--skip-pareto", action="store_true")
+    parser.add_argument(
+        "--only", choices=tuple(PROBES), default=None, help="one probe only (printed, not written)"
+    )
     args = parser.parse_args()
     load = os.getloadavg()[0]
+    if args.only:
+        print(args.only, probe(args.only))
+        return
     names = [n for n in PROBES if not (args.skip_pareto and n == "pareto")]
     got = {}
     for name in names:
