@@ -28,6 +28,7 @@ from ..operating import OperatingPoint
 from ..results import Status, message
 from ..tribodynamics import check_inputs
 from . import augmented_lagrangian as al
+from .metrics import FIELDS
 from .problem import (
     CONSTRAINTS,
     EPIGRAPH_MAX,
@@ -286,7 +287,7 @@ def build_problem(
     bounds, shape, both_gears,
 ):  # fmt: skip
     """Checked inputs → (TipReliefProblem, names, x0 [n] SI, limits dict). The scale and reference
-    are placeholders (one and zero) until ``calibrate_scale``."""
+    are placeholders (one and zero) until ``normalise_objective``."""
     fidelity = Fidelity.fast() if fidelity is None else fidelity
     check_inputs(pair, lubricant, surfaces, op, fidelity)
     check_objective(objective)
@@ -343,7 +344,7 @@ def failed_points_message(problem, status) -> str:
     return "; ".join(items)
 
 
-def calibrate_scale(problem, u0, limits_array):
+def normalise_objective(problem, u0, limits_array):
     """The problem with its objective normalised at the start (unit largest gradient in box units;
     the epigraph's reference the start peak), and the start's raw output."""
     n_con = constraint_count(problem, limits_array)
@@ -377,8 +378,7 @@ def _natural_multipliers(problem, lam, limits, n_points):
 
 
 def _entries(problem, name) -> int:
-    from .metrics import FIELDS
-
+    """Constraint entries per point of a quantity: one, or one per position and flank pair."""
     return 2 * problem.fidelity.n_positions if name in FIELDS else 1
 
 
@@ -437,7 +437,7 @@ def result_from(problem, outcome, start_out, names, x0, limits, op, final_out) -
 def _solve(problem, names, x0, limits, op, *, ctol, gtol, max_evaluations):
     limits_array = jnp.asarray([limits[n] for n in problem.constraint_names], dtype=float)
     u0 = to_box(problem, x0)
-    problem, start_out, n_con = calibrate_scale(problem, u0, limits_array)
+    problem, start_out, n_con = normalise_objective(problem, u0, limits_array)
     if not np.all(np.asarray(start_out["status"]) == 0):
         outcome = al.Outcome(
             u=u0, evaluation=evaluation(start_out), multipliers=np.zeros(n_con), rho=0.0,
