@@ -240,35 +240,26 @@ def _pair_of_numbers(name, value):
     return float(value[0]), float(value[1])
 
 
-def run(args: argparse.Namespace) -> int:
-    import jaxgear as jg
-    from jaxgear.cli.config import (
-        check_keys,
-        check_top_level,
-        gear_pair_from_config,
-        load_toml,
-        operating_from_config,
-    )
-    from jaxgear.fidelity import Fidelity
-    from jaxgear.optimise import _check_positive_float, _check_steps
+def read_config(args, keys) -> tuple[dict, dict, list[float] | None]:
+    """(config, its [optimise] table, the speeds) of an optimise/pareto command, keys checked."""
+    from jaxgear.cli.config import check_keys, check_top_level, load_toml
 
     cfg = load_toml(args.config) if args.config else {}
     check_top_level(cfg, ("gear", "operating", "optimise"))
     opt_cfg = dict(cfg.get("optimise", {}))
-    check_keys(opt_cfg, _OPTIMISE_KEYS, "optimise")
+    check_keys(opt_cfg, keys, "optimise")
     speeds = parse_speeds(args.speeds, args.speed_range)
     if speeds is None and "speeds_rpm" in opt_cfg:
         speeds = parse_speeds(",".join(str(v) for v in opt_cfg["speeds_rpm"]), None)
-    target = args.target or opt_cfg.get("target", "tip_relief")
-    if target not in TARGETS:
-        raise ValueError(f"optimise.target = {target!r} is not valid; valid choices: {TARGETS}")
-    steps = args.steps if args.steps is not None else opt_cfg.get("steps", 40)
-    lr = args.learning_rate if args.learning_rate is not None else opt_cfg.get("learning_rate", 0.1)
-    shape = args.shape or opt_cfg.get("shape")
-    # Cheap checks first: bad numbers fail before any geometry or compile work.
-    _check_steps(steps)
-    _check_positive_float("learning_rate", lr)
-    design = design_inputs(args, opt_cfg) if target == "tip_relief" else None
+    return cfg, opt_cfg, speeds
+
+
+def model_inputs(args, cfg):
+    """(pair, lubricant, surfaces, operating point, fidelity) of an optimise/pareto command."""
+    import jaxgear as jg
+    from jaxgear.cli.config import gear_pair_from_config, operating_from_config
+    from jaxgear.fidelity import Fidelity
+
     pair = gear_pair_from_config(cfg)
     op_cfg = operating_from_config(cfg)
     if args.torque is not None:
@@ -283,7 +274,25 @@ def run(args: argparse.Namespace) -> int:
         if args.fidelity == "fast"
         else Fidelity(dynamics="quasi_static", friction="regression")
     )
-    lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
+    return pair, jg.presets.mil_l_23699(), jg.presets.ground(), op, fidelity
+
+
+def run(args: argparse.Namespace) -> int:
+    import jaxgear as jg
+    from jaxgear.optimise import _check_positive_float, _check_steps
+
+    cfg, opt_cfg, speeds = read_config(args, _OPTIMISE_KEYS)
+    target = args.target or opt_cfg.get("target", "tip_relief")
+    if target not in TARGETS:
+        raise ValueError(f"optimise.target = {target!r} is not valid; valid choices: {TARGETS}")
+    steps = args.steps if args.steps is not None else opt_cfg.get("steps", 40)
+    lr = args.learning_rate if args.learning_rate is not None else opt_cfg.get("learning_rate", 0.1)
+    shape = args.shape or opt_cfg.get("shape")
+    # Cheap checks first: bad numbers fail before any geometry or compile work.
+    _check_steps(steps)
+    _check_positive_float("learning_rate", lr)
+    design = design_inputs(args, opt_cfg) if target == "tip_relief" else None
+    pair, lub, surf, op, fidelity = model_inputs(args, cfg)
     common = dict(speeds_rpm=speeds, fidelity=fidelity, steps=steps, learning_rate=lr)
 
     if target == "tip_relief":

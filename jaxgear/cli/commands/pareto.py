@@ -15,7 +15,8 @@ from jaxgear.cli.commands.optimise import (
     _relief_bounds,
     _unit,
     design_inputs,
-    parse_speeds,
+    model_inputs,
+    read_config,
 )
 from jaxgear.design.pareto import TRADES
 from jaxgear.design.problem import OBJECTIVES
@@ -75,26 +76,11 @@ def _limits(text, trade):
 
 
 def run(args: argparse.Namespace) -> int:
-    import jaxgear as jg
-    from jaxgear.cli.config import (
-        check_keys,
-        check_top_level,
-        gear_pair_from_config,
-        load_toml,
-        operating_from_config,
-    )
     from jaxgear.cli.design_args import display
     from jaxgear.design.pareto import pareto_front
     from jaxgear.design.plots import plot_pareto
-    from jaxgear.fidelity import Fidelity
 
-    cfg = load_toml(args.config) if args.config else {}
-    check_top_level(cfg, ("gear", "operating", "optimise"))
-    opt_cfg = dict(cfg.get("optimise", {}))
-    check_keys(opt_cfg, _PARETO_KEYS, "optimise")
-    speeds = parse_speeds(args.speeds, args.speed_range)
-    if speeds is None and "speeds_rpm" in opt_cfg:
-        speeds = parse_speeds(",".join(str(v) for v in opt_cfg["speeds_rpm"]), None)
+    cfg, opt_cfg, speeds = read_config(args, _PARETO_KEYS)
     objective, constraints, torques = design_inputs(args, opt_cfg)
     trade = args.trade or opt_cfg.get("trade", "dte_rms")
     if trade not in TRADES:
@@ -103,22 +89,9 @@ def run(args: argparse.Namespace) -> int:
     n_points = args.n_points if args.n_points is not None else opt_cfg.get("n_points", 10)
     grid = args.grid if args.grid is not None else opt_cfg.get("grid", 5)
     budget = args.max_evaluations or opt_cfg.get("max_evaluations", 80)
-    pair = gear_pair_from_config(cfg)
-    op_cfg = operating_from_config(cfg)
-    if args.torque is not None:
-        op_cfg["torque"] = args.torque
-    op = jg.OperatingPoint(
-        torque=op_cfg.get("torque", 700.0),
-        speed_rpm=op_cfg.get("speed_rpm", 2000.0),
-        inlet_temperature=op_cfg.get("inlet_temperature", 363.15),
-    )
-    fidelity = (
-        Fidelity.fast()
-        if args.fidelity == "fast"
-        else Fidelity(dynamics="quasi_static", friction="regression")
-    )
+    pair, lub, surf, op, fidelity = model_inputs(args, cfg)
     front = pareto_front(
-        pair, jg.presets.mil_l_23699(), jg.presets.ground(), op, speeds_rpm=speeds,
+        pair, lub, surf, op, speeds_rpm=speeds,
         torques=torques, fidelity=fidelity, objective=objective, trade=trade, limits=limits,
         n_points=n_points, constraints=constraints, bounds=_relief_bounds(opt_cfg),
         shape=args.shape or opt_cfg.get("shape"), both_gears=not args.per_gear, grid=grid,
