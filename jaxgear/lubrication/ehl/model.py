@@ -117,85 +117,79 @@ MODEL_NUMBERS = (
 class EHLModel(eqx.Module):
     """Configuration of ``solve_ehl``: static choices (changing one recompiles) and the contact's
     physical constants ``MODEL_NUMBERS`` (μb, nβσ, σ/β, Λ: float64 arrays, traced: changing one
-    never recompiles, and the solution can be differentiated with respect to each).
+    never recompiles, and the solution can be differentiated with respect to each). Methods:
+    REFERENCE §5, §8; S. Li, Tribol. Int. 88 (2015).
 
     Attributes:
-        n_nodes: grid nodes N; (N − 1) should hold a power of 2 for grid sequencing.
-        x_in, x_out: domain in Hertz half-widths (widened automatically for thick films,
-        ``auto_domain``).
+        n_nodes: grid nodes N, ≥ 17 (default 257); N − 1 should hold a power of 2 for grid
+            sequencing.
+        x_in, x_out: domain in Hertz half-widths, x_in < 0 < x_out (default −4.5, 1.5; widened
+            for thick films by ``auto_domain``).
         auto_domain: widen the inlet to √(50 H_est) and the outlet to 1.2 √(2 H_est) when larger,
-            H_est the Moes central film in Hertz units (fully flooded inlet at low M).
-        viscosity: "roelands" or "barus".
-        compressibility: "dowson_higginson" or "incompressible".
-        shear: "newtonian", "eyring_paper" (η* = η/cosh(τm/τ0), paper Eq. 4), "eyring_exact"
-            (τ = τ0 asinh(η us/(τ0 h))) or "eyring_split". It enters Reynolds' flow coefficient and
-            the friction/heat terms. η* is the tangent viscosity dτm/dγ̇ of Eyring Couette flow and
-            τm h/us its secant: "eyring_split" uses the secant (the stress τm) in the sliding
-            friction and heat, and η* in the flow coefficient, the Poiseuille heat and the damping
-            (the response to a small pressure flow or sliding-speed change on top of the shear).
-        fb_smoothing: δ of the Fischer-Burmeister function (in ph); None (default): 1e-8, and
-            1e-6 for deterministic rough films (``smoothing``). δ relaxes the complementarity to
-            P·g = δ²/2, so where the exact pressure is below δ ph it is held near δ ph instead,
-            above all at the first node past the inlet's P = 0; under the thick inlet film that
-            jump's Poiseuille heat grows as 1/Δx. Measured (1000 rpm, SRR 0.3, smooth, 257 / 513
-            / 1025 / 2049 nodes): rolling loss 158.6 / 191.6 / 308.4 / 753.8 W/m at δ = 1e-6
-            (every film's default until 2026-11-29), 146.4 / 148.2 / 148.6 / 148.8 W/m at 1e-8
-            and 1e-10; the sliding loss and the Newton iterations the same. Deterministic rough
-            films keep 1e-6: their relaxed warm starts were tuned there, and at 1e-8 a step of
-            the ground film at speed E falls back to the cold solve (99 Newton iterations against
-            8; tests/test_mixed_thermal.py), while their rolling heat is the asperity edges'.
-        tolerance: ‖F‖∞ below which a Newton solve has converged.
-        max_iterations: Newton iterations per grid level (and per continuation step).
-        coarsest_nodes: smallest grid of the sequence.
+            H_est the Moes central film in Hertz units (fully flooded inlet at low M). Default True.
+        viscosity: "roelands" (default) or "barus".
+        compressibility: "dowson_higginson" (default) or "incompressible".
+        shear: "newtonian", "eyring_paper" (default; η* = η/cosh(τm/τ0), paper Eq. 4),
+            "eyring_exact" (τ = τ0 asinh(η us/(τ0 h))) or "eyring_split". It enters Reynolds' flow
+            coefficient and the friction/heat terms. η* is the tangent viscosity dτm/dγ̇ of Eyring
+            Couette flow and τm h/us its secant: "eyring_split" uses the secant (the stress τm) in
+            the sliding friction and heat, and η* in the flow coefficient, the Poiseuille heat and
+            the damping (the response to a small pressure flow or sliding-speed change on top of
+            the shear).
+        fb_smoothing: δ of the Fischer-Burmeister function, in ph, in (0, 1e-2]; None (default):
+            1e-8, and 1e-6 for deterministic rough films (``smoothing``). δ relaxes the
+            complementarity to P·g = δ²/2, so where the exact pressure is below δ ph it is held
+            near δ ph, above all at the first node past the inlet's P = 0, whose Poiseuille heat
+            grows as 1/Δx: at 1e-6 a smooth film's rolling loss grows ~5× from 257 to 2049 nodes,
+            at 1e-8 by under 2 %. Deterministic rough films keep 1e-6, where their relaxed warm
+            starts converge (their rolling heat is the asperity edges').
+        tolerance: ‖F‖∞ below which a Newton solve has converged, in (0, 1e-2] (default 1e-9).
+        max_iterations: Newton iterations per grid level and per continuation step (default 30).
+        coarsest_nodes: smallest grid of the sequence, ≥ 17 (default 65; above ``n_nodes``: a
+            single grid).
         continuation_steps: steps of the piezo-viscous exponent (s = 1/n … 1) on the coarsest grid
-            in the second cold attempt (the first uses s = 1/4, 1/2, 3/4, 1). From 1025 nodes on, a
-            third attempt (smooth and statistical films) takes those steps up to s = 0.75, sequences
-            to the finest grid there and continues s → 1 on it adaptively.
+            in the second cold attempt (the first uses s = 1/4, 1/2, 3/4, 1); default 12. From
+            1025 nodes on, a third attempt (smooth and statistical films) takes those steps up to
+            s = 0.75, sequences to the finest grid there and continues s → 1 on it adaptively.
         warm_iterations: Newton iterations allowed for a warm start before falling back to a cold
-        solve.
-        deformation: "dense", "fft" (DC-FFT for residuals; the Jacobian stays dense), "auto" (fft
-            above 1025 nodes). Grids that take Krylov directions (``linear_solver``) always use
-            DC-FFT.
-        wedge_order: upwind order of the wedge term (1 or 2).
+            solve (default 12).
+        deformation: "dense", "fft" (DC-FFT for residuals; the Jacobian stays dense) or "auto"
+            (default: fft above 1025 nodes). Grids that take Krylov directions
+            (``linear_solver``) always use DC-FFT.
+        wedge_order: upwind order of the wedge term, 1 or 2 (default).
         thermal: thermal EHL (REFERENCE §5): the film's mean temperature (paper Eq. 8 profile, with
             convection) and both surface temperatures (Jaeger, paper Eq. 9) from the heat flux of
             Eq. 12, viscosity and density re-evaluated at the film temperature, iterated
             (Picard, warm-started, the temperature update relaxed by Aitken's Δ² rule) until the
             film temperature moves by < 1 % of its rise, at most ``thermal_iterations`` times.
-            False skips all of it.
-        thermal_iterations: most outer temperature updates; None: 4 for smooth and statistical
-            films, 32 for deterministic roughness (whose hot films need 15-23 relaxed updates).
+            False (default) skips all of it.
+        thermal_iterations: most outer temperature updates; None (default): 4 for smooth and
+            statistical films, 32 for deterministic roughness (whose hot films need 15-23 relaxed
+            updates).
         thermal_rtol, thermal_atol: the temperature updates stop (and the solution counts as
             thermally converged) once the film temperature the film implies is within
-            max(thermal_rtol × its largest rise, thermal_atol K) of the one it was solved with.
-            Defaults 0.01 and 0.05 K. That error does not shrink with the time step: a transient
-            passage's film temperature converges in Δt only with tighter values (measured on a
-            bump passing a thermal film, 129 nodes, 2000 rpm, backward Euler: 0.24 K apart
-            both between Δt/2 and Δt/8 and between Δt/4 and Δt/8 with the defaults, out of a
-            3.2 K rise; at 1e-4 and 1e-4 K first order, 0.024 and 0.008 K,
-            tests/test_time_scheme.py; raise ``thermal_iterations`` with them).
-        boundary_friction: μb of asperity contact (paper: 0.1).
+            max(thermal_rtol × its largest rise, thermal_atol K) of the one it was solved with;
+            thermal_rtol in (0, 0.5] (default 0.01), thermal_atol in (0, 10] K (default 0.05). That
+            error does not shrink with the time step: a transient passage's film temperature
+            converges in Δt only with tighter values (e.g. 1e-4 and 1e-4 K, with more
+            ``thermal_iterations``).
+        boundary_friction: μb of asperity contact, in [0, 1] (default 0.1, the paper's).
         contact_threshold: a node is in asperity contact where h is below this fraction of the
             smooth central-film estimate (there the Poiseuille flow has vanished: ε ∝ h³ < 1e-7 of
-            its smooth value, and Reynolds reduces to paper Eq. 4b/4c). Smooth indicator.
+            its smooth value, and Reynolds reduces to paper Eq. 4b/4c). Smooth indicator. In
+            [1e-4, 0.1] (default 5e-3).
         roughness_steps: n, the first step 1/n of the adaptive continuation in the roughness
             amplitude of a cold deterministic mixed solve, which starts from the smooth solution.
-            Measured on one engagement along the path (257 nodes, ground, 900 steps): n = 8 takes
-            30 670 Newton iterations at 3500 rpm and 78 925 at 500 rpm, against 35 055 and 87 160
-            with n = 4 (38 025 / 96 971 with 2, 35 848 / 92 497 with 3, 33 327 / 80 941 with 6,
-            28 498 / 77 100 with 16), 892-899 of the steps converged with any of these; the steady
-            solves at the pitch contact (257-1025 nodes) take 15 fewer iterations with 8 than with 4
-            where they converge, to the same solutions, and fail where 4 failed (500 rpm, 513 and
-            1025 nodes).
-        mixed: how rough surfaces are treated. "deterministic": the roughness profiles in the film
-            (paper Eq. 5) with the unified Reynolds equation (Hu-Zhu); needs Δx ≲ 2 µm. A cold
-            solve continues adaptively in the roughness amplitude from the smooth film. Measured
-            with ``presets.ground()`` at the paper's pitch contact: converges at 3500 rpm
-            (λ ≈ 0.4) on 257-1025 nodes; at 500 rpm (λ ≈ 0.1) on 257 nodes, while on 513 and 1025
-            nodes the continuation stalls (at 0.775 and 0.43 of the roughness) and the film is
-            reached by the pseudo-time march (``pseudo_transient_steps``). A continuation that
-            accepted at least one step and then failed is not repeated by a second cold attempt
-            (it would start from the same smooth film and take the same path).
+            Default 8: about 10 % fewer Newton iterations along an engagement than 4, with the
+            same steps converged.
+        mixed: how rough surfaces are treated. "deterministic" (default): the roughness profiles
+            in the film (paper Eq. 5) with the unified Reynolds equation (Hu-Zhu); needs
+            Δx ≲ 2 µm. A cold solve continues adaptively in the roughness amplitude from the
+            smooth film; in deep mixed films (λ ≈ 0.1, 513 nodes and finer) that continuation can
+            stall, and the film is then reached by the pseudo-time march
+            (``pseudo_transient_steps``). A continuation that accepted at least one step and then
+            failed is not repeated by a second cold attempt (it would start from the same smooth
+            film and take the same path).
             "statistical": the film on the surfaces' mean planes (``asperity.py``): the film
             unknown is the mean-plane separation d = h0 + x²/2R + V(p), which may be negative;
             the flow carries the average gap h_T(d) with Patir and Cheng's pressure flow factor
@@ -206,8 +200,9 @@ class EHLModel(eqx.Module):
             non-contact fraction 1 − A_r/A at the average gap, the asperities carry μb p_a. It
             spans full film (λ ≳ 3: the smooth film) to boundary lubrication (λ → 0: the dry
             rough contact) and needs only the composite roughness σ.
-        asperity_density_product, asperity_slope_ratio: nβσ and σ/β of the statistical model
-            [typical values for ground steel: 0.05, 0.01].
+        asperity_density_product, asperity_slope_ratio: nβσ in [1e-4, 1] (default 0.05) and σ/β
+            in [1e-6, 1] (default 0.01) of the statistical model [typical values for ground
+            steel].
         limiting_shear_coefficient: Λ of a limiting shear stress τL = Λ p (Bair & Winer) capping,
             smoothly, the fluid shear stress of the friction and the sliding heat at the local
             fluid pressure (``rheology.log_limited_stress``), in (0, 1]; None (default): no cap.
@@ -218,52 +213,39 @@ class EHLModel(eqx.Module):
             fails but got close, two more rounds of half as many sweeps from where it stopped,
             then (passage steps) a start from the half step; then the cold solve. 0: none, Newton
             from the plain warm start, which then nearly always falls back to the cold solve.
-            Measured over one engagement along the path (900 steps, 257 nodes), against 0 in the
-            same hour: 108 against 172 s at 3500 rpm, 150 against 172 s at 500 rpm. None
-            (default): 100 iso-thermal, 50 thermal (``_relaxation_sweeps``).
+            None (default): 100 iso-thermal, 50 thermal (``_relaxation_sweeps``).
         pseudo_transient_steps: the last attempt of a deterministic rough film whose other
             attempts failed: pseudo-transient continuation (``_pseudo_march``), at most this many
             pseudo-time steps (each a continuation in the roughness from the smooth film with a
             squeeze term towards the last state, Δτ doubling from Δx/ur), then the steady problem
-            from where the march settled. 0: no such attempt. The steps of a transient passage
-            (``solve_ehl_passage``) never take it. Measured at 500 rpm, pitch contact, ground,
-            where the direct solve fails: 700 N m on 513 nodes 34 s, on 1025 nodes 103 s, 1500 N m
-            on 513 nodes 22 s after compilation; a deterministic solve compiles ~1.5 s longer.
+            from where the march settled. Default 64; 0: no such attempt. The steps of a transient
+            passage (``solve_ehl_passage``) never take it.
         temperature_steps: a thermal deterministic rough film re-solved at updated temperatures
             (each update of the temperature iteration) whose warm Newton fails gets a
             continuation in the temperature rise from the one its start was solved at, first
             step 1/``temperature_steps`` of the update (``_temperature_continuation``), before
-            the relaxed rounds and the cold solve. 0: none. Measured on one thermal engagement
-            along the path (3500 rpm, 257 nodes, 900 steps): 514 continuations, 464 converged,
-            35 Newton iterations each against the cold solve's ~200; 100 898 against 141 633
-            Newton iterations in all, 88.9 against 104.6 s, the same 895 steps converged.
+            the relaxed rounds and the cold solve: ~35 Newton iterations where the cold solve
+            takes ~200. Default 2; 0: none.
         linear_solver: how the Newton directions of grids from 1025 nodes are found. "dense"
             (default): the assembled Newton matrix's LU (O(N³), single precision refined on large
             grids). "krylov": GMRES on Jacobian-vector products by forward mode through the
             residual (DC-FFT deformation), preconditioned by block-Jacobi LUs of 128-node blocks
             and the load row (``_krylov_direction``): O(N log N) a Krylov vector, no N × N
-            matrix. The same discrete system to the same tolerance (solutions within 1e-6,
-            tests/test_ehl_krylov.py); coarser levels of the grid sequence keep the dense LU, and
-            the implicit derivative keeps its dense rule. Measured on the held pitch contact at
-            3500 rpm (RESULTS ``mixed_held_steps``): a step of the deterministic passage 2.2-3.5×
-            cheaper on 1025-2049 nodes (ground 2.25 against 7.97 s on 2049 nodes, polished 0.13
-            against 0.33 s), the same films. The polished film's warm starts then converge
-            without the relaxation sweeps (``relaxation_sweeps=0``: 0.08 s a step).
+            matrix. The same discrete system to the same tolerance (solutions within 1e-6);
+            coarser levels of the grid sequence keep the dense LU, and the implicit derivative
+            keeps its dense rule. A deterministic passage step costs 2.2-3.5× less on 1025-2049
+            nodes (benchmarks/RESULTS.md, ``mixed_held_steps``).
         time_scheme: the squeeze term ∂(ρh)/∂t of a transient passage (``solve_ehl_passage``).
             "backward_euler" (default): first order. "bdf2": second-order backward differences
             on variable steps (the first transient step, and a step after a failed one, backward
             Euler); the same residual, one more film level carried. In a thermal passage the
             film temperature's ∂ϕm/∂t and the solids' steps in depth are BDF2 too, the solids'
             two earlier fields read at their material points' feet by cubic interpolation: a
-            thermal passage then converges at second order in Δt on a fixed grid (a speed
-            transient, tests/test_time_scheme.py: backward Euler's 0.076 / 0.020 K at Δt/2 /
-            Δt/4 against Δt/8, BDF2's 0.022 / 0.0047 K) and on the grid a load transient moves
-            (0.0027 / 0.00057 K), once the material that saw the start from cold has left the
-            contact (a flux switched on heats the solids as √t) and with tight ``thermal_rtol``. A
-            deterministic rough film's loss needs it: on the polished film at
-            the pitch contact (3500 rpm, 2049 nodes; RESULTS ``mixed_time_steps``) backward Euler at
-            Δt = Δx/ur is 36 % above the Δt → 0 limit, BDF2 25 % there and 6 % at Δx/(2 ur),
-            with as many Newton iterations a step (both Eulerian; see ``transport``).
+            thermal passage then converges at second order in Δt, once the material that saw the
+            start from cold has left the contact (a flux switched on heats the solids as √t) and
+            with tight ``thermal_rtol``. A deterministic rough film's loss needs it: on the
+            polished film at Δt = Δx/ur backward Euler is 36 % above the Δt → 0 limit, BDF2 at
+            Δx/(2 ur) 6 % (benchmarks/RESULTS.md, ``mixed_time_steps``).
         transport: how a transient step discretises the film's transport u_m ∂(ρh)/∂x + ∂(ρh)/∂t.
             "eulerian" (default): the upwind wedge term plus the squeeze term at the node.
             "characteristic": the two together as the material derivative D(ρh)/Dt along the
@@ -274,26 +256,21 @@ class EHLModel(eqx.Module):
             when a step carries it a whole number of cells, and a steady film keeps the steady
             wedge (first- or second-order upwind at Δt = Δx/ur). The Eulerian terms instead damp
             and lag a roughness a few cells long, and the film answers that with pressure flow,
-            so with Poiseuille heat. Measured at the pitch contact (3500 rpm, SRR 0.3; RESULTS
-            ``mixed_time_steps``): on the polished film the loss at Δt = 0.5, 1, 2 and 4 Δx/ur
-            agrees within 1.9 % on 2049 nodes (the Eulerian schemes: 2.5× between C = 4 and
-            their Δt → 0 limit) and 1025 nodes give within 4 % of it (Eulerian: 1.8×); on the
-            ground film (257 nodes) the loss is ~4× below the Eulerian schemes', whose excess is
-            Poiseuille heat. Steady solves have no squeeze term and ignore it. Use it with BDF2
-            and steps of a few cells: for a steady film it is the upwind difference over the C
-            cells a step spans (backward Euler: first order), so a step must stay short against
-            the outlet constriction. Measured on a held smooth film (2000 rpm, BDF2, 11 steps):
-            the minimum film moves by ≤ 2 % up to C Δx = 0.05 b (513 nodes, C ≤ 4), by 6 % at
-            0.09 b (513, C = 8), and by 85 % at 0.19 b (129, C = 4); the coupled model's
-            transient rung, a third of a Hertz width a step, is no place for it.
+            so with Poiseuille heat: on the polished film the characteristic loss agrees within
+            2 % over Δt = 0.5-4 Δx/ur, the Eulerian ones vary 2.5× (benchmarks/RESULTS.md,
+            ``mixed_time_steps``). Steady solves have no squeeze term and ignore it. Use it with
+            BDF2 and steps of a few cells: for a steady film it is the upwind difference over the
+            C cells a step spans, so a step must stay short against the outlet constriction
+            (C Δx ≲ 0.05 b keeps the minimum film within 2 %); the coupled model's transient rung,
+            a third of a Hertz width a step, is no place for it.
         hardness: None (default: elastic solids, no bound on the pressure) or the pressure at
-            which the surfaces yield, Pa (elastic-perfectly plastic; ~7e9 for case-hardened gear
-            steel, about three times its yield stress). Where the pressure reaches it, it stays
-            there and the gap opens by a plastic gap δ ≥ 0 (``EHLSolution.plastic_gap``) that
-            keeps the Reynolds equation, so the flow, at every node: P and δ complementary,
-            through one unknown per node (``_Level.plastic``). It bounds the asperity pressure of
-            deterministic roughness, where an elastic half-space puts none (13.5 GPa on the
-            ground surfaces at 500 rpm on 1025 nodes). A passage
+            which the surfaces yield, Pa, in [1e8, 1e11] (elastic-perfectly plastic; ~7e9 for
+            case-hardened gear steel, about three times its yield stress). Where the pressure
+            reaches it, it stays there and the gap opens by a plastic gap δ ≥ 0
+            (``EHLSolution.plastic_gap``) that keeps the Reynolds equation, so the flow, at every
+            node: P and δ complementary, through one unknown per node (``_Level.plastic``). It
+            bounds the asperity pressure of deterministic roughness, where an elastic half-space
+            puts none (above 10 GPa on the ground surfaces). A passage
             (``passage.solve_ehl_passage``) runs the surfaces in: what a step flattens stays in
             both profiles (half each) and travels with each surface, so a later step's δ is only
             what more yields. On the statistical film (``mixed="statistical"``) it caps the
