@@ -79,7 +79,7 @@ def _schedules(model: EHLModel, dtype):
     3500 rpm) the reduced-exponent problems are the hard ones. There, from the Hertz start at
     s = 1/4, Newton lets the film offset run away (H0 → 10³ × the Moes film, ‖F‖∞ ≈ 0.2, no
     solution on that branch) on some domains, while at s = 1 it converges in ~11 iterations on the
-    coarsest grid (measured 2026-11-26: M = 4.2 on −7 … 1.5 half-widths)."""
+    coarsest grid (M = 4.2 on −7 … 1.5 half-widths)."""
     k = model.continuation_steps
     i = np.arange(1, k + 1)
     rows = [np.ceil(4.0 * i / k) / 4.0, i / k, i / k, np.ones(k)]
@@ -89,10 +89,10 @@ def _schedules(model: EHLModel, dtype):
 _DIRECT_ROW = 3  # the schedule row without continuation (see ``_schedules``)
 
 
-# exponent s at which the third cold attempt reaches the finest grid. Measured (Barus,
-# incompressible, M = 200, L = 15, ᾱ ≈ 85, 2049 nodes): the first two attempts stall at
-# ‖F‖∞ ≈ 1e-2 next to the one-cell pressure spike at the outlet; continuing s = 0.8 → 1 on the
-# finest grid converges (2026-11-22).
+# exponent s at which the third cold attempt reaches the finest grid. Why: in hard piezo-viscous
+# contacts on fine grids (Barus, incompressible, M = 200, L = 15, 2049 nodes) the first two
+# attempts stall at ‖F‖∞ ≈ 1e-2 next to the one-cell pressure spike at the outlet, while the
+# continuation of the last steps of s on the finest grid converges.
 _FINE_CONTINUATION_START = 0.75
 _FINE_CONTINUATION_NODES = 1025  # grids from this size on get the third attempt
 
@@ -142,9 +142,8 @@ def _warm_start(fine: _Level, init_x, init_p, init_h0, window: bool = False):
         return jnp.concatenate([p, _offset_for_central_film(fine, p, hc)[None]])
     # rough film whose roughness moved since (a transient step): the previous pressure averaged
     # over 5 cells, so that its asperity spikes, which stand where the roughness was, are spread
-    # and the relaxation builds the new ones (measured with the relaxed warm start, 3 rounds: 138
-    # against 129 of 152 steps along the path converged at 3500 rpm, 70 against 54 of 111 at
-    # 500 rpm; over 3 or 7 cells fewer)
+    # and the relaxation builds the new ones (more warm starts converge than unaveraged, or
+    # averaged over 3 or 7 cells)
     p = jnp.where(init_h0[2] > 0.5, _box_average(p), p)
     # the previous H0 − H_c carried over (dimensionless, so the same for any contact with a
     # Hertz-like pressure); the window-matched offset if the previous solution gave none
@@ -160,27 +159,16 @@ _RELAX_JACOBI = 0.5  # ω of the plain Jacobi changes (Poiseuille-dominated node
 _RELAX_SWITCH = 0.3  # wedge-dominated: |∂R_i/∂P_i| below this × the film's self-influence term
 _RELAX_LOAD_GAIN = 0.02  # film-offset change per sweep, × the load error × the reference film
 # relaxed warm attempts of a deterministic film: relaxation_sweeps then Newton, then twice half as
-# many sweeps from where Newton stopped and Newton again. Measured over 76 steps along the path at
-# 3500 rpm (257 nodes): 47 of the warm starts converge after the first round, 64 after three (100
-# sweeps then 150 more without a Newton in between: 57); over 70 at 500 rpm, 25 and 34.
+# many sweeps from where Newton stopped and Newton again (the later rounds rescue about a third
+# more warm starts than the first alone, and more than the same sweeps without Newton between)
 _RELAX_ROUNDS = 3
 
 
 def _relaxation_sweeps(model: EHLModel) -> int:
     """The relaxation sweeps of a deterministic film's warm start: the model's, or by default 100
-    iso-thermal and 50 thermal. Measured over one engagement along the path (257 nodes, ground,
-    900 steps, 2026-11-27, each column in one hour; run s / steps converged / Newton iterations):
-
-    | sweeps | thermal, 3500 rpm | thermal, 500 rpm | iso-thermal, 3500 rpm | iso-thermal, 500 rpm |
-    |---|---|---|---|---|
-    | 100 | 63.6 / 895 / 78 827 | 100.2 / 898 / 107 837 | 30.8 / 900 / 30 467 | 73.1 / 900 / 79 861 |
-    | 50 | 57.3 / 895 / 81 488 | 88.5 / 898 / 111 952 | – | – |
-    | 25 | 55.9 / 895 / 85 374 | 90.8 / 900 / 117 290 | 34.4 / 900 / 46 999 | 71.9 / 899 / 92 816 |
-
-    (thermal 3500 rpm, 10 sweeps: 57.7 s, 91 571; none: 72.6 s, 152 775). 100 sweeps cost ~9 ms,
-    ~11 Newton iterations' worth. Fewer sweeps leave more of the first solves to the later
-    attempts in both cases; why that costs the thermal passage less is measured, not explained.
-    The losses over the converged steps were the same to 0.1 %."""
+    iso-thermal and 50 thermal: over an engagement along the path (257 nodes, ground, 500 and
+    3500 rpm) within 3 % of the run time of the cheapest of 25, 50 and 100 sweeps, with the same
+    steps converged and the same losses to 0.1 %. 100 sweeps cost about 11 Newton iterations."""
     if model.relaxation_sweeps is not None:
         return model.relaxation_sweeps
     return 50 if model.thermal else 100
@@ -190,11 +178,8 @@ def _half_step_start(model: EHLModel, inp: _Inputs, u_start):
     """A start for a transient deterministic step whose relaxed warm starts failed: the half step
     (each surface displaced half as far, Δt/2) solved from ``u_start`` by one relaxation and Newton
     round, its pressure averaged over 5 cells and relaxed on this step's system. Only the start
-    changes, not the problem solved. Measured over 152 steps along the path at 3500 rpm (257
-    nodes), the half step solved in three rounds: of the 19 steps whose three relaxed rounds
-    failed, the half step converged for 16 and this step then for 12; at 500 rpm, of 52, for 27
-    and 20. One round, kept since it costs less: one engagement 77 against 75 s at 3500 rpm, 167
-    against 183 s at 500 rpm. Returns (start, Newton iterations)."""
+    changes, not the problem solved: it rescues about half the steps whose relaxed rounds
+    failed. Returns (start, Newton iterations)."""
     half = eqx.tree_at(
         lambda i: (i.film_offset, i.inv_time_step),
         inp,
@@ -220,10 +205,8 @@ def _distributive_relaxation(level: _Level, u, sweeps: int):
     """``sweeps`` damped Jacobi sweeps of the Reynolds equation from ``u`` (distributive where the
     wedge and squeeze terms dominate, plain where the Poiseuille term does; cavitation by
     projection on P ≥ 0, the film offset nudged towards the load balance); returns the last
-    iterate (``u`` itself if that is not finite). Returning the iterate of smallest ‖F‖∞ instead
-    was measured worse: over 76 steps along the path at 3500 rpm, 42 warm starts converged against
-    47 (it often keeps the unrelaxed start, whose ‖F‖∞ the first sweeps raise), and over 70 at 500
-    rpm 20 against 25.
+    iterate (``u`` itself if that is not finite). Not the iterate of smallest ‖F‖∞: that is often
+    the unrelaxed start, whose ‖F‖∞ the first sweeps raise, and fewer warm starts converge from it.
 
     Why: a deterministic rough film's transient step cannot be reached by Newton from the previous
     step's solution (it stalls at a local minimum of the Fischer-Burmeister merit, ‖F‖∞ ≈ 0.1-1,
