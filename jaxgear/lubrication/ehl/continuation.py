@@ -25,10 +25,10 @@ def _temperature_continuation(model: EHLModel, inp: _Inputs, u_start):
 
     Why: after an update that moves the hot spots at the asperity edges by ~100 K, the warm Newton
     from the last film often fails, and the cold solve (the smooth film, then the continuation in
-    the roughness) costs ~200 iterations. Relaxing the update itself instead (failed warm re-solves
-    retried at a quarter of it) was measured to break the Aitken secant of the temperature
-    iteration: 506 s and 824 of 900 steps converged on the engagement where this continuation
-    gives 88.9 s and 895 (see ``EHLModel.temperature_steps``)."""
+    the roughness) costs ~200 iterations. Not by relaxing the update itself (failed warm re-solves
+    retried at a fraction of it): that breaks the Aitken secant of the temperature iteration, and
+    an engagement then costs several times more and converges fewer steps
+    (``EHLModel.temperature_steps``)."""
     previous = inp.temperature_rise_previous
 
     def system_at(r):
@@ -43,10 +43,9 @@ def _temperature_continuation(model: EHLModel, inp: _Inputs, u_start):
 
 
 #: the largest pressure change of an accepted pseudo-time step (× ph) below which the march tries
-#: the steady problem from its state. Measured with the eager version of the march at the case it
-#: was built for (500 rpm, pitch contact, ground, 513 nodes, 2026-11-27): the steady solve failed
-#: from states whose last step changed the pressure by 0.12-0.16 ph and converged, in 12
-#: iterations, from one at 0.11 ph.
+#: the steady problem from its state. At the case the march was built for (500 rpm, pitch contact,
+#: ground, 513 nodes) the steady solve fails from states whose last step changed the pressure by
+#: 0.12-0.16 ph and converges, in 12 iterations, from one at 0.11 ph.
 SETTLE_CHANGE = 0.12
 _PSEUDO_SMALLEST = 2.0**-10  # the shortest pseudo-time step, × Δx/ur
 
@@ -83,8 +82,8 @@ def _pseudo_march(model: EHLModel, fine: _Level, u, u_smooth, rho_h_smooth, step
     continuation with a squeeze term, which ties each node's film to a reference film, converges;
     as Δτ grows the reference matters less and the state approaches the steady film. Newton from
     the last state alone (no continuation) does not do: at 500 rpm and 1500 N m on 513 nodes its
-    steps failed from Δτ = Δx/ur on and shrank below Δx/(1024 ur) (measured 2026-11-27), where
-    the continuation's steps grew to 256 Δx/ur in 12 steps. A real transient step (σ > 0) is
+    steps fail from Δτ = Δx/ur on and shrink below Δx/(1024 ur), where the continuation's steps
+    grow to 256 Δx/ur in 12 steps. A real transient step (σ > 0) is
     marched to its own solution the same way: the pseudo term vanishes at a steady state of the
     march."""
     n = fine.n
@@ -133,15 +132,12 @@ def _rough_homotopy(fine: _Level, rho_h_smooth):
     perturbations of the smooth steady solution grow with r (a steady solve has no squeeze term:
     only the roughness moves).
 
-    Why: a transient step that falls back to the cold solve used to continue in the roughness alone,
-    with the squeeze term pulling the film towards the previous step's rough ρ̄H from r = 0 on: at
-    small r a smooth gap against a rough previous film, an O(1) inconsistency from the first step.
-    Measured on one engagement along the path (257 nodes, ground, 900 steps; old and new code in
-    the same hour, a one-off script logging each attempt): at 3500 rpm 26 of 212 such cold solves
-    failed their first roughness step and 16 steps failed in all; now 2 of 201 and 2 steps, 39.5
-    against 56.0 s; at 500 rpm 28 of 506 and 43 steps, now 0 of 486 and 5 steps, 91 against 97 s. Scaling the squeeze term by r instead
-    (steady at r = 0) also converges them (896 and 875 of 900 steps) but needs longer continuations
-    at 500 rpm (median 202 against 127 Newton iterations)."""
+    Why both: a continuation in the roughness alone, with the squeeze term pulling the film towards
+    the previous step's rough ρ̄H from r = 0 on, starts from a smooth gap against a rough previous
+    film, an O(1) inconsistency from the first step: 5-12 % of such cold solves along an
+    engagement then fail their first roughness step, against ≤ 1 % with the blend. Scaling the
+    squeeze term by r instead (steady at r = 0) converges nearly as many but needs longer
+    continuations (median ~1.6× the Newton iterations at 500 rpm)."""
 
     # r = 0: the reference the smooth steady film solves the system with. Without the wedge term
     # (a step along the characteristics, ``EHLModel.transport``) the squeeze term has to carry
@@ -171,12 +167,12 @@ def _adaptive_continuation(model: EHLModel, system_at, u, k0, r0, steps: int):
     Used for the roughness amplitude (deterministic mixed film, from the smooth solution;
     ``steps`` = ``roughness_steps``) and for the piezo-viscous exponent (third cold attempt of a
     smooth film; ``_EXPONENT_STEPS``). Steps start at 1/``steps``; each starts from the secant
-    extrapolation of the last two accepted states; a step whose Newton solve fails within half the model's iteration budget is retried at
-    half the increment (down to 1/256 of the first), an accepted one lets the next grow by a third.
-    Measured at the paper's pitch contact (700 N m, 3500 rpm, ground, λ ≈ 0.4): four fixed roughness
-    steps failed beyond 0.8 of the roughness at 257 nodes and beyond 0.3 at 1025 nodes (residual
-    0.5-4); the accepted steps shrink to ~0.03 at 513 nodes and ~0.015 at 1025 nodes, where
-    asperity contact spreads.
+    extrapolation of the last two accepted states; a step whose Newton solve fails within half the
+    model's iteration budget is retried at half the increment (down to 1/256 of the first), an
+    accepted one lets the next grow by a third. Why adaptive: at the paper's pitch contact (700 N m,
+    3500 rpm, ground, λ ≈ 0.4) four fixed roughness steps fail beyond 0.8 of the roughness at 257
+    nodes and beyond 0.3 at 1025 nodes, where the accepted steps shrink to ~0.015 as asperity
+    contact spreads.
     """
     dtype = u.dtype
     first = jnp.asarray(1.0 / steps, dtype=dtype)
