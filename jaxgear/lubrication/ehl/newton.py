@@ -20,11 +20,10 @@ def _norm_inf(f):
 
 _MIXED_PRECISION_NODES = 513  # from this size on, the LU of the Newton matrix is single precision
 # and from this size on for deterministic rough films, whose many Newton iterations (transient
-# passages: ~100 a step) make the LU most of their cost. Measured on the thermal deterministic
-# engagement along the path (3500 rpm, 257 nodes, 900 steps, same hour): 78.7 against 88.9 s with
-# the double LU, 96 075 against 100 898 iterations, 896 against 895 steps converged; the mean loss
-# moved by 0.8 %: 15 of the steps landed on another discrete solution (loss > 20 % apart), as the
-# solver's path decides on such films (see the README, Deterministic roughness)
+# passages: ~100 a step) make the LU most of their cost: a thermal engagement along the path at
+# 257 nodes runs ~11 % faster, the same steps converged; a few steps land on another discrete
+# solution of such a film, as the solver's path decides there (docs/limitations.md, deterministic
+# roughness)
 _MIXED_PRECISION_NODES_ROUGH = 257
 _DIRECTION_TOLERANCE = 1e-3  # accepted relative residual ‖J d + F‖/‖F‖ of a mixed-precision step
 
@@ -146,12 +145,10 @@ def _krylov_direction(level: _Level, u, s, f):
     GMRES stops at ‖J d + F‖ ≤ ``_DIRECTION_TOLERANCE``‖F‖ (inexact Newton: each Newton iteration
     still contracts the residual by about that factor) or after ``_KRYLOV_CYCLES`` cycles.
 
-    Measured on the first transient step at the pitch contact (3500 rpm, λs 2.5 µm; GMRES vectors
-    to 1e-3, a one-off study with SciPy on the assembled J, 2026-11-27): the polished film 7 on 1025
-    nodes with blocks of 64 (6 with 128), the ground film 19 (11 with 128); without a
-    preconditioner 21-58, with the previous step's exact LU 74-289 (the film's Jacobian moves with
-    the roughness). The Newton iterations a step do not depend on the GMRES tolerance between 1e-2
-    and 1e-5 (polished, 2049 nodes: 6-8 a step with each).
+    Why 128-node blocks: on a transient step at the pitch contact (3500 rpm, 1025 nodes) GMRES
+    needs 6-11 vectors with them, 7-19 with blocks of 64, 21-58 without a preconditioner and
+    74-289 with the previous step's exact LU (the film's Jacobian moves with the roughness). The
+    Newton iterations a step do not depend on the GMRES tolerance between 1e-2 and 1e-5.
     """
     factors = _block_preconditioner(level, u, s)
     _, jvp = jax.linearize(lambda v: level.residual(v, s), u)

@@ -94,13 +94,12 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
         return inp_next, settled, relax
 
     # Outer (Picard) iteration: Reynolds at fixed temperatures (Newton, warm started), then the
-    # temperatures of its heat source. It
-    # stops once they agree with those the film was solved with (the remaining steps are skipped by
-    # lax.cond: no work when solved one contact at a time; a scan, not a while loop, so that
-    # reverse-mode differentiation works). Under vmap the skipped steps still run; the vmap-lazy
-    # ``cond_any_member`` was measured slower here (an 8-point parallel sweep, thermal transient
-    # mixed, 32 positions × 129 nodes: 5.4-5.8 s against 4.2 s), so it is kept to the solver's
-    # fallback attempts, where it pays.
+    # temperatures of its heat source. It stops once they agree with those the film was solved
+    # with (the remaining steps are skipped by lax.cond: no work when solved one contact at a time;
+    # a scan, not a while loop, so that reverse-mode differentiation works). Under vmap the skipped
+    # steps still run; the vmap-lazy ``cond_any_member`` is slower here (30-40 % on a parallel
+    # thermal transient mixed sweep), so it is kept to the solver's fallback attempts, where it
+    # pays.
     def stay(op):
         return op[0], op[1], jnp.asarray(True), op[2]
 
@@ -112,15 +111,12 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
         new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol.iterations)
         # a deterministic film whose re-solve failed (every attempt) ends the iteration, reported
         # not converged: the temperatures of a film that is not a Reynolds solution lead nowhere,
-        # and each further re-solve ran every cold attempt (~500 Newton iterations each). Measured
-        # on one thermal engagement along the path (257 nodes, same hour, against going on to the
-        # last update): 3500 rpm 66.3 against 77.4 s, 894 against 896 of 900 steps converged;
-        # 2000 rpm 72.6 against 99.5 s, 898 both (one step had burnt 30 000 iterations on 18
-        # failed re-solves); 4000 rpm 66.1 against 90.8 s, 893 against 890; 500 rpm no re-solve
-        # failed. A failed first solve still gets its updates: new temperatures can make it
-        # solvable (measured at 2000 rpm: 1 such step converged). Two failed solves in a row as
-        # the stop instead cascaded at 3500 rpm: the failed step's successor restarts steady,
-        # and from step 812 on every restart failed (807 of 900 converged).
+        # and each further re-solve runs every cold attempt (~500 Newton iterations each): a
+        # thermal engagement along the path costs 15-30 % less than going on to the last update,
+        # with about as many steps converged. A failed first solve still gets its updates: new
+        # temperatures can make it solvable. Not two failed solves in a row as the stop: that
+        # cascades (the failed step's successor restarts steady, and its restarts can fail in
+        # turn).
         stop = ~new.converged if mixed == "deterministic" else jnp.asarray(False)
         return new, inp_next, stop, relax
 
@@ -172,10 +168,9 @@ _AITKEN_MIN = 0.05  # smallest relaxation factor of the temperature update
 # the hot film's: at speed E (ground, 700 N m) it asked for a film 1292 K hot on 513 nodes, the
 # Reynolds solves at the 400-900 K films that followed failed, and after 16 updates the solve was
 # reported as not converged. Limited to 200 K a step it settles in 23 updates to a film up to 348 K
-# hot; on 257 nodes the same solutions come out with fewer Newton iterations (measured 2026-11-27:
-# 704 against 2451 at 3500 rpm, 846 against 1278 at 500 rpm, 808 against 1140 at 2000 rpm; losses
-# within 0.04 %, the thermal tolerance). 100 K: 818 at 3500 rpm on 257 nodes, not settled in 16 on
-# 513. Smooth and statistical films keep the unlimited update (their first rises are tens of K).
+# hot; on 257 nodes the same solutions (losses within the thermal tolerance) come out with 30-70 %
+# fewer Newton iterations than unlimited; 100 K does not settle in 16 updates on 513 nodes. Smooth
+# and statistical films keep the unlimited update (their first rises are tens of K).
 _DETERMINISTIC_TEMPERATURE_STEP = 200.0
 
 
@@ -187,7 +182,7 @@ def _aitken(x, g, state, max_step=None):
     (unrelaxed: the smooth and statistical films' usual 2-3 updates); one that oscillates gets
     ω < 1. Why: with the deterministic roughness at full ground amplitude the unrelaxed update
     swings between films 150 and 740 K hot (its Poiseuille heat falls as the viscosity does), and
-    never settles (measured at speed E, 257 nodes, 16 updates: change still 250 K).
+    never settles (at speed E, 257 nodes: the update still moves it by 250 K after 16).
 
     ``max_step`` (K, optional): ω is further limited so that no node's temperature moves by more
     than this in one update (a trust region; the limited ω is the one the next Δ² step reads).
@@ -215,7 +210,7 @@ def _aitken(x, g, state, max_step=None):
 # heat only flows into the film, so a rise below 0 is numerical undershoot). The bounds keep the
 # film within 150-1600 K for every valid inlet (200-600 K), where the lubricant models stay finite:
 # the linear thermal expansion's density reaches 0 near 1700 K (Mil-L-23699), and a bound of 1500 K
-# let a failed 1025-node passage step report NaN viscosities and losses (2026-11-27)
+# lets a failed 1025-node passage step report NaN viscosities and losses
 _MAX_RISE = 1000.0
 _MIN_RISE = -50.0
 
