@@ -148,24 +148,21 @@ def _film_at_feet(model, mixed, surfaces, x, shift, x_prev, rho_h, rho, d, radiu
     Why the roughness apart: a step along the characteristics is exact for a film carried at the
     mean velocity only if it reads that film where it stood. Linear interpolation between nodes
     flattens a roughness a few cells long: on the polished film at the pitch contact (2049 nodes,
-    BDF2) Courant numbers 0.5 and 0.25, whose feet fall between nodes, gave a loss 20-22 % above
-    the integer ones (1, 2, 4: within 0.6 % of each other), as the grid that follows the Hertz
-    width along the path would too; with the roughness evaluated, C = 0.5 is 1.3 % below C = 1.
+    BDF2) Courant numbers 0.5 and 0.25, whose feet fall between nodes, give a loss 20-22 % above
+    the integer ones (as the grid that follows the Hertz width along the path would too); with the
+    roughness evaluated, C = 0.5 is 1.3 % below C = 1.
     The rest of ρh (the smooth gap and the deformation) and the density are interpolated.
 
     Upstream of the earlier grid's first node (its grid narrower: the Hertz width grows with the
     load; or a foot upstream of the inlet) the rigid gap x²/(2R) (``radius`` R, this step's) and
     the roughness are taken out, the rest (h0, the deformation: slowly varying there) extrapolated
     linearly, and the gap and the roughness there put back at the first node's density (the
-    inlet's pressure is ~0). Why: held at the first node's value, as before 2026-11-28, the
-    earlier film was read too thin by the gap's growth there, and the squeeze term filled a gap
-    that was not opening. Where the load doubles in a step of a third of a Hertz width (the
-    coupled transient rung's jumps; 257 nodes, 3500 rpm, smooth, iso-thermal) the inlet moves 56
-    cells; that step's loss was 0.5 % lower (16 586 against 16 669 W/m), its film the same to
-    1e-4, the later steps' losses within 2e-5. Inside the earlier grid ρh is interpolated as it
-    is: in the Hertz zone the deformation cancels the rigid gap's curvature, so taking the gap out
-    there would make the rest curved (a one-off run that did so moved the same step's loss by
-    another 0.4 % and its central film by 0.1 %)."""
+    inlet's pressure is ~0). Why: held at the first node's value, the earlier film would be read
+    too thin by the gap's growth there, and the squeeze term would fill a gap that is not opening
+    (where the load doubles in a step of a third of a Hertz width, the coupled transient rung's
+    jumps, the inlet moves ~56 cells and that step's loss moves by 0.5 %). Inside the earlier grid
+    ρh is interpolated as it is: in the Hertz zone the deformation cancels the rigid gap's
+    curvature, so taking the gap out there would make the rest curved."""
     foot = x - shift if model.transport == "characteristic" else x
     offset_prev = _roughness_offset(mixed, surfaces, x_prev, d)
     rest_prev = rho_h - rho * offset_prev
@@ -406,7 +403,7 @@ class _Level(eqx.Module):
         # so the assembly is one fused elementwise pass over n² entries, with no gathers
         # the barrier ties the influence rows to this Newton iterate: otherwise XLA hoists the four
         # n × n slices (and masks) out of the Newton while-loop as loop invariants, materialising
-        # them before every solve even when it takes no iteration (15 ms at N = 1025, measured)
+        # them before every solve even when it takes no iteration (~15 ms at N = 1025)
         kernel_rows = self.kernel_rows
         if kernel_rows is None:  # a Krylov level's J for the implicit derivative: built here
             kernel_rows = deformation_mod.influence_rows(n, self.spacing, before=2, after=1)
