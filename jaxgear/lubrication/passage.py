@@ -66,13 +66,12 @@ def _advect_to(temperature, x_old, feet, cubic=False, entering=True):
 
     Why past the outlet: the grid follows the Hertz width, so where the load rises fast its outlet
     moves further in a step than the material does, and material that stood past the earlier
-    grid's outlet enters this one. Read as 0 (the bulk temperature), it would leave
-    a cold dip in the solids behind the outlet: a load doubled in one step after 100 steps of
-    Δx/ur (65 nodes, 2000 rpm, SRR 0.3, thermal smooth film, backward Euler) put the surfaces
-    0.07-0.9 K above the bulk at the 4 nodes past the old outlet where the outlet had stood at
-    2.1 K (now 1.9-2.7 K), and the dip travelled out over the next steps. That material left the
-    contact at about the outlet's temperature, and keeps it over a step: it cools by conduction
-    into the depth over many."""
+    grid's outlet enters this one. Read as 0 (the bulk temperature), it would leave a cold dip in
+    the solids behind the outlet (after a load doubled in one step, surfaces near the bulk
+    temperature at the nodes past the old outlet, where the outlet stood about 2 K above it), and
+    the dip would travel out over the next steps. That material left the contact at about the
+    outlet's temperature, and keeps it over a step: it cools by conduction into the depth over
+    many."""
     dx = x_old[1] - x_old[0]
     at = jnp.clip(feet, x_old[0] - dx, x_old[-1] + dx)
     if cubic:
@@ -120,43 +119,27 @@ def _film_rise_at(x, x_old, rise_old, cubic):
     the end nodes extrapolated from them, up to one cell (held beyond).
 
     Why past the ends: the grid follows the Hertz width, so under a rising load its end nodes lie
-    past the previous step's. Read as 0 there (the inlet temperature), the
-    outlet node's ∂ϕm/∂t pulled its film towards the inlet temperature: under a load rising by
-    30 % over 24 Δx/ur (129 nodes, 2000 rpm, thermal smooth film, BDF2) its temperature rise was
-    0.12 K where the node two cells upstream had 2.8 K, and its error against Δt/16 fell only as
-    Δt^0.7 (0.31, 0.20, 0.11 K at Δt/2, Δt/4, Δt/8), the largest error of the film. The film
-    leaves through the outlet, so what stood just past it continues what stood at it; at the inlet
-    the rise is small either way."""
+    past the previous step's. Read as 0 there (the inlet temperature), the outlet node's ∂ϕm/∂t
+    would pull its film towards the inlet temperature (under a rising load, a rise of 0.12 K
+    where the node two cells upstream has 2.8 K), the film's largest error, converging in Δt at
+    order 0.7 only. The film leaves through the outlet, so what stood just past it continues what
+    stood at it; at the inlet the rise is small either way."""
     return _advect_to(rise_old[:, None], x_old, x, cubic, entering=False)[:, 0]
 
 
 def _temperature_start(mixed, prev, x, inlet, shift):
     """The film temperature rise (K, on this step's nodes ``x``) a step's temperature iteration
     starts from: the previous step's solution ``prev``, and, with deterministic roughness, moved
-    downstream by ``shift`` = ur Δt (the inlet at 0). Read as the film's ∂ϕm/∂t reads it past the
-    previous grid's outlet (``_advect_to``; read as 0 there, the statistical
-    thermal engagement along the path at 3500 rpm gives 171.460 W against 171.371 W: where the
-    updates stop within their 1 % tolerance, which puts that loss 0.3 % below the tight fixed
-    point, 171.932 W, under either start).
+    downstream by ``shift`` = ur Δt (the inlet at 0); read past the previous grid's outlet as the
+    film's ∂ϕm/∂t reads it (``_advect_to``). The start decides only where the updates stop within
+    their tolerance, not the temperature iteration's fixed point.
 
-    Why: a deterministic rough film's hot spots stand at its asperity contacts and thin films, which
-    move with the surfaces, about one cell a step (Δt = Δx/ur); left where they were, the
-    temperature updates have to move them, at the nodes they left and reached. Measured on one
-    thermal engagement along the path (257 nodes, ground, 900 steps; against the unshifted start in
-    the same hour): 3500 rpm 62.0 against 68.0 s, 78 827 against 84 383 Newton iterations, 895
-    against 894 steps converged; 2000 rpm 72.9 against 73.8 s, 80 585 against 85 042, 898 both.
-    The temperature iteration's fixed point is unchanged (the mean loss over the converged steps
-    moved by 0.7 % at 3500 rpm, 0.1 % at 2000 rpm: which discrete solution a step lands on). Smooth
-    and statistical films, whose temperatures vary over the Hertz width, keep the unshifted start.
-    Measured earlier the same day, before a failed warm re-solve continued in the temperature
-    (``ehl.continuation._temperature_continuation``), the same start cost more: 211 631 against
-    141 633 iterations, when a re-solve that failed fell back to the cold solve.
-    Tried and not kept (3500 rpm, same code otherwise): a continuation in the share of the time
-    step for a first solve whose warm Newton failed (roughness, squeeze term and temperatures
-    together from the previous step's solution): 87 Newton iterations a solve, 281 of 299
-    converged, in the iso-thermal passage 129 and 255 of 288 (the cold solve there: 97);
-    temperatures smoothed over 9 cells at the start of the cold solve's roughness continuation:
-    155 against 174 iterations a cold solve, 61.9 against 62.0 s."""
+    Why the shift: a deterministic rough film's hot spots stand at its asperity contacts and thin
+    films, which move with the surfaces, about one cell a step (Δt = Δx/ur); left where they were,
+    the temperature updates have to move them, at the nodes they left and reached. The shifted
+    start saves 5-7 % of the Newton iterations of a thermal engagement along the path (257 nodes,
+    ground), with the same steps converged. Smooth and statistical films, whose temperatures vary
+    over the Hertz width, keep the unshifted start."""
     rise = (prev.temperature - inlet)[:, None]
     if mixed != "deterministic":
         return _advect_to(rise, prev.x, x, entering=False)[:, 0]
@@ -284,9 +267,8 @@ def _step(model, numbers, mixed, lubricant, surfaces, solids, depth, carry, cont
         # the solids' backward-Euler-shaped step: BDF2 is the same depth system with Δt/a0 from
         # the blended start (``_bdf2``), its two previous levels read at their material points'
         # feet by cubic interpolation. Why cubic: with linear interpolation the error depends on
-        # the fraction of a cell a step moves the material more than on Δt (a speed transient,
-        # 129 nodes: 0.072 and 0.0015 K at Δt/2 and Δt/4 against Δt/8; cubic 0.022 and 0.0047
-        # K, second order; tests/test_time_scheme.py). Backward Euler keeps the linear reads
+        # the fraction of a cell a step moves the material more than on Δt, and BDF2 loses its
+        # second order in Δt. Backward Euler keeps the linear reads.
         a0, blend = (1.0, None) if first or not bdf2 else _bdf2(older, prev_ok & older_ok, dt)
         frees = []
         for k, temp in enumerate((temp1, temp2)):
@@ -511,8 +493,8 @@ def solve_ehl_passage(
     solids = (steel(), steel()) if solids is None else tuple(solids)
     mixed = "smooth" if surfaces is None else model.mixed
     # the steps of a passage do not end in the pseudo-time march of a steady deterministic film
-    # (``ehl.continuation._pseudo_march``): on an engagement (257 nodes, 3500 rpm) it did not
-    # rescue the step that failed, and it made the engagement cost 49 s against 33 s
+    # (``ehl.continuation._pseudo_march``): along an engagement it rescues no failed step and
+    # costs ~50 % more run time
     model = dataclasses.replace(model, pseudo_transient_steps=0)
     sols, worn = _passage(
         model,
