@@ -106,7 +106,7 @@ def _rk4(dyn: GearDynamics, z, s, n_steps):
     """``n_steps`` RK4 steps of ``dyn.step`` from τ = 0 (a whole number of mesh periods when
     n_steps is a multiple of the steps per period). Used for the attractor, whose settling is a
     transient whose details do not matter: about 3.5× cheaper per step on a CPU than a diffrax
-    solve per period (measured, 2026-11-24), and cheap to compile (the shooting's diffrax solve is
+    solve per period, and cheap to compile (the shooting's diffrax solve is
     not traced again)."""
     return jax.lax.fori_loop(
         0, n_steps, lambda i, z: _rk4_step(dyn, z, s, i * dyn.step, dyn.step), z

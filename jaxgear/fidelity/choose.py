@@ -1,4 +1,4 @@
-"""Automatic choice of the fidelity ladder's rungs (DESIGN §4, issue 7): the cheapest rungs whose
+"""Automatic choice of the fidelity ladder's rungs (DESIGN §4): the cheapest rungs whose
 *measured* error stays under a tolerance for the scenario at hand, with the reasons in words.
 
 Two steps, both on the host (no simulation is run):

@@ -460,9 +460,9 @@ class Fidelity(eqx.Module):
         (Greenwood-Tripp) asperity model, not the measured profiles in the film. The
         deterministic solver exists (``mixed_model="deterministic"``) but the transient rung
         refuses it: between two mesh positions the profiles would move by far more than a grid
-        cell, and its film is not grid-converged on grids a coupled run can afford (docs, known
-        limitations: deterministic roughness). The open contact parameters keep their literal
-        defaults here; ``paper_calibrated()`` is the same model with two of them fitted."""
+        cell, and its film is not grid-converged on grids a coupled run can afford
+        (docs/limitations.md, deterministic roughness). The open contact parameters keep their
+        literal defaults here; ``paper_calibrated()`` is the same model with two of them fitted."""
         base = dict(
             back_flank="same",
             dynamics="tribo_dynamic",
@@ -479,14 +479,13 @@ class Fidelity(eqx.Module):
         """``paper()`` with its two open contact parameters set to the paper's loss level: the
         Eyring stress as the fluid traction (``shear="eyring_split"``, a model choice, not fitted)
         and the Greenwood-Tripp density product nβσ = 0.08 (``asperity_density_product``; 0.05 in
-        ``paper()``), fitted by ``jg.calibrate`` (Levenberg-Marquardt; ``benchmarks/calibration.py``)
-        to the paper's quasi-static Φ̄ at A, B, D and E: 0.0785 ± 0.0037 on 129 nodes, about
-        0.0796 on this preset's 257 nodes (whose losses are 1.8-2 % lower), so 0.08 at the
-        standard error's precision. One constant cannot follow the paper's speed trend: the fit
-        leaves A and B 5-12 % above the paper and D and E 12-13 % below. Left as checks: point C,
-        the tribo-dynamic losses and every trend. A fitted preset, like the calibrated blanks of
+        ``paper()``), fitted by ``jg.calibrate`` to the paper's quasi-static Φ̄ at points A, B, D
+        and E (0.08 within the fit's standard error; ``benchmarks/calibration.py``). One constant
+        cannot follow the paper's speed trend: A and B stay above the paper's losses, D and E below
+        (by up to ~13 %). A fitted preset, like the calibrated blanks of
         ``presets.li2015_pair_calibrated()``: use it to study the paper's trends at the paper's
-        loss level, not as a check of that level (docs, validation)."""
+        loss level, not as a check of that level; point C, the tribo-dynamic losses and the trends
+        remain checks. ``changes``: flat Fidelity keywords applied on top."""
         calibrated = dict(
             shear=CALIBRATED_SHEAR, asperity_density_product=CALIBRATED_DENSITY_PRODUCT
         )

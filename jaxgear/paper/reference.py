@@ -42,19 +42,15 @@ FIELD_ROLL_ANGLE_DEG = {7: 25.0, 12: 17.0}
 #: no asperity pressures to show. The profiles are the runs' synthetic surfaces as a stylus
 #: instrument measures them (``field_surfaces``): band-limited at λs = 2.5 µm, the ISO 3274 cutoff
 #: for λc = 0.8 mm (the paper put measured profiles in its film). Unfiltered, the exponential
-#: autocorrelation has no finest scale and the film moves with the grid (RESULTS
+#: autocorrelation has no finest scale and the film moves with the grid (benchmarks/RESULTS.md,
 #: ``roughness_resolution``). Filtered, this contact settles by 2049 nodes (Δx ≈ 0.5 µm at 17°):
-#: at the quasi-static 17° contact at 3500 rpm (RESULTS ``fig12_resolution``) polished p_max 1.750
-#: / 1.745 / 1.737 GPa and h_min 0.188 / 0.190 / 0.189 µm on 1025 / 2049 / 4097 nodes, ground
-#: p_max 4.94 / 4.86 GPa on 1025 / 2049 (29 s for the ground solve on 2049 nodes). The ground
-#: film's asperity load is what still moves (1.6 % of the load on 1025 nodes, none on 2049: the
-#: > 3 GPa peaks are micro-EHL pressure in a film 26 nm thin at its thinnest), as at the pitch
-#: contact, where that film needs Δx ≲ λs/13 (``roughness_resolution``); a ground solve on 4097
-#: nodes at the pitch contact did not finish in 20 min. (On 513 unfiltered nodes, the setting
-#: before 2026-11-27, the polished p_max came out 1.80 GPa here and 2.00 GPa at the paper
-#: fidelity's speed E.) Steady and iso-thermal: the thermal deterministic film's Poiseuille heat
-#: is not grid-converged (README, Deterministic roughness); and the roughness is frozen at the
-#: instant (moving roughness: ``solve_ehl_passage``).
+#: polished p_max and h_min within 0.5 % of 4097 nodes, ground p_max within 2 % of 1025 nodes
+#: (``fig12_resolution``). The ground film's asperity load is what still moves (the > 3 GPa peaks
+#: are micro-EHL pressure in a film 26 nm thin at its thinnest), as at the pitch contact, where
+#: that film needs Δx ≲ λs/13 (``roughness_resolution``). Steady and iso-thermal: the thermal
+#: deterministic film's Poiseuille heat is not grid-converged (docs/limitations.md,
+#: deterministic roughness); and the roughness is frozen at the instant (moving roughness:
+#: ``solve_ehl_passage``).
 FIELD_DETERMINISTIC_NODES = 2049
 FIELD_SHORT_CUTOFF = 2.5e-6  # m, λs of ISO 3274 for λc = 0.8 mm (ground and polished flanks)
 

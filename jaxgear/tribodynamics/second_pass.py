@@ -31,7 +31,7 @@ from .result import STATUS_ATTRACTOR, assemble, without_derivative_where
 # dynamics ~0.9 ms a cycle, so 64 of 256 cycles keep the contacts at about the dynamics' cost.
 ATTRACTOR_CONTACT_CYCLES = 64
 # Settling cycles of an attractor continued from the previous speed's (continuation sweeps): the
-# attractor moves little between neighbouring speeds (measured: see tests/test_attractor.py).
+# attractor moves little between neighbouring speeds (checked by the attractor tests).
 ATTRACTOR_WARM_SETTLE = 200
 
 def back_flank_power(pair, op, fidelity, mesh, mesh_force, contacts):
@@ -80,7 +80,7 @@ def record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st):
         # Evaluated exactly, the closed form follows a rattle's loads from zero to impact
         # (power laws from the orbit are extrapolated there, and carry no load to a slot the
         # orbit leaves unloaded); it tracks the EHL solver's forces within 16 % at one contact
-        # (tests/test_ehl_formula.py) and Φ̄ within 6.1 % over the baseline sweep.
+        # and Φ̄ within 6.1 % over the baseline sweep.
         proxy_fid = fidelity.replace(friction="ehl_formula")
         if fidelity.friction == "ehl_smooth":  # no asperity load on the smooth rung
             surfaces = eqx.tree_at(lambda s: s.scale, surfaces, jnp.zeros_like(surfaces.scale))
@@ -130,8 +130,8 @@ def orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
     (``DynamicResponse.back_force``) is negative, solved as an attractor's (``record_contacts``,
     ``back_flank_power``); zeros where it has none (no periodic orbit of the calibrated pair's
     baseline has any; a light load or a small backlash gives them). A vmap-lazy cond: a sweep
-    none of whose points strikes back skips it (run for every member, it cost the 149-speed
-    parallel sweep at ``Fidelity.fast()`` 12 %: 40.5 against 36.0 s compiled)."""
+    none of whose points strikes back skips it (run for every member, it costs a parallel sweep
+    at ``Fidelity.fast()`` ~12 % more)."""
     force = st["back_force"][None]  # [1, M]
 
     # the fidelity goes in the operand: its constants are arrays of this trace, which a branch
