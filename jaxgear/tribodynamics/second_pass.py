@@ -260,8 +260,8 @@ def attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status
     unstable = (state["dynamics_ok"] < 0.5) & jnp.all(jnp.isfinite(state["guess"]))
     # The branch is costly to compile (the dynamics in time): traced once, without the all-members
     # path. In a vmapped sweep whose batch mixes stable and unstable points, the unstable ones run
-    # it one by one (mixed="map"): the batched select ran the 2000-cycle integration for every
-    # point, 615 s for the 149-speed baseline sweep at fast() with 27 points on an attractor.
+    # it one by one (mixed="map"): a batched select would run the 2000-cycle integration for
+    # every point of the batch.
     return cond_any_member(unstable, on_attractor, keep, operand, all_true_path=False, mixed="map")
 
 
