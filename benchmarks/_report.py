@@ -1,4 +1,5 @@
-"""Shared helpers for the benchmarks: timing and writing a section of benchmarks/RESULTS.md."""
+"""Shared helpers for the benchmarks and the studies: timing, and writing a section of a results
+file (benchmarks/RESULTS.md, or a study's studies/<name>/README.md)."""
 
 from __future__ import annotations
 
@@ -95,9 +96,15 @@ def time_call(fn, *args, repeats: int = 20):
     return first, statistics.median(runs)
 
 
-def write_section(name: str, body: str) -> None:
-    """Replace (or append) the section between <!-- BEGIN name --> and <!-- END name -->."""
-    text = RESULTS.read_text() if RESULTS.exists() else "# jaxgear benchmark results\n"
+def write_section(name: str, body: str, path: Path = RESULTS) -> None:
+    """Replace (or append) the section between <!-- BEGIN name --> and <!-- END name --> of
+    ``path`` (benchmarks/RESULTS.md by default; a study passes its own README.md)."""
+    path = Path(path)
+    text = (
+        path.read_text()
+        if path.exists()
+        else ("# jaxgear benchmark results\n" if path == RESULTS else f"# {path.parent.name}\n")
+    )
     block = f"<!-- BEGIN {name} -->\n{body.rstrip()}\n<!-- END {name} -->"
     pattern = re.compile(
         rf"<!-- BEGIN {re.escape(name)} -->.*?<!-- END {re.escape(name)} -->", re.S
@@ -107,7 +114,7 @@ def write_section(name: str, body: str) -> None:
         if pattern.search(text)
         else text.rstrip() + "\n\n" + block + "\n"
     )
-    RESULTS.write_text(text)
+    path.write_text(text)
 
 
 def effective_friction(result) -> float:
