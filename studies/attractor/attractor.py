@@ -12,20 +12,27 @@ the attractor the gears settle on (``Fidelity.attractor_periods``, status 6). Th
    attractor on and off: the speeds that change, Φ̄ and DTE RMS on and off there, and the wall time
    of each sweep (compiled: run cost; first: with compilation).
 
-Writes the section ``attractor`` of benchmarks/RESULTS.md. Run (repository root):
-    python benchmarks/attractor.py [--step 25]
+Writes the section ``attractor`` of studies/attractor/README.md. Run (repository root):
+    python studies/attractor/attractor.py [--step 25]
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import jax
 
 jax.config.update("jax_enable_x64", True)
 
 import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
+
 from _report import machine, time_call, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
@@ -103,7 +110,7 @@ def main(argv=None):
     extra = (sweeps["on"][2] - sweeps["off"][2]) / max(n_att, 1)
     body = "\n".join(
         [
-            "## Speeds without a stable periodic orbit: the attractor (benchmarks/attractor.py)",
+            "## Speeds without a stable periodic orbit: the attractor (`attractor.py`)",
             "",
             f"Machine: {machine()}.",
             "",
@@ -139,7 +146,7 @@ def main(argv=None):
             *table,
         ]
     )
-    write_section("attractor", body)
+    write_section("attractor", body, README)
     print(body)
 
 

@@ -9,14 +9,14 @@ the Greenwood-Tripp nβσ and σ/β (``Fidelity.asperity_density_product``, ``as
 runs the quasi-static paper fidelity (thermal, statistical mixed, transient; 32 positions × 257
 nodes) at the nominal speeds of the points A, B, D, E, varying one parameter at a time from the
 defaults, then the tribo-dynamic paper fidelity at the default nβσ and at 0.08 (the value the
-quasi-static sweep finds reaching the paper), and writes its section of RESULTS.md. No default is
-changed: a sensitivity study.
+quasi-static sweep finds reaching the paper), and writes its section of
+studies/friction_sensitivity/README.md. No default is changed: a sensitivity study.
 
-Run: ``python benchmarks/friction_sensitivity.py [--quick] [--fresh]`` (``--quick``: points B and
-E only; ``--fresh``: discard the cached rows). Each new static configuration (nβσ, σ/β, μb) is a
-new compilation of about 60-90 s, and LLVM may run out of memory after many compilations in one
-process, so each group of variants runs in its own process (``--group NAME``, also usable by hand)
-and caches its rows in ``CACHE``; a rerun resumes from it. Full: about 15 min on 2 cores for the
+Run: ``python studies/friction_sensitivity/friction_sensitivity.py [--quick] [--fresh]``
+(``--quick``: points B and E only; ``--fresh``: discard the cached rows). Each new static
+configuration (nβσ, σ/β, μb) is a new compilation of about 60-90 s, and LLVM may run out of memory
+after many compilations in one process, so each group of variants runs in its own process
+(``--group NAME``, also usable by hand) and caches its rows in ``CACHE``; a rerun resumes from it. Full: about 15 min on 2 cores for the
 quasi-static sweep, 10 min more for the tribo-dynamic group.
 """
 
@@ -35,6 +35,10 @@ from pathlib import Path
 import jax
 
 jax.config.update("jax_enable_x64", True)
+
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 
 from _report import effective_friction, machine, write_section  # noqa: E402
 
@@ -291,7 +295,7 @@ def write_results(points) -> None:
     order = {"default": 0, **{p: i + 1 for i, p in enumerate(PARAMETERS)}}
     rows.sort(key=lambda r: (order[r["param"]], r["value"] or 0.0, "ABCDE".index(r["point"])))
     lines = [
-        "## Friction level: the open parameters τ0, nβσ, σ/β, μb (`benchmarks/friction_sensitivity.py`)",
+        "## Friction level: the open parameters τ0, nβσ, σ/β, μb (`friction_sensitivity.py`)",
         "",
         f"Machine: {machine()}. Quasi-static paper fidelity (thermal, statistical mixed, transient, "
         "32 positions × 257 nodes), calibrated pair, ground, 700 N m, 90 °C, the paper's η* shear "
@@ -329,7 +333,7 @@ def write_results(points) -> None:
         *_reading(rows, points),
         *_tribo_dynamic_table(td, rows),
     ]
-    write_section("friction_sensitivity", "\n".join(lines))
+    write_section("friction_sensitivity", "\n".join(lines), README)
 
 
 def _tribo_dynamic_table(td, rows) -> list[str]:

@@ -11,8 +11,9 @@ Candidates: none; the previous step's exact LU (a chord method across steps); J'
 half-width w (w = 1: the tridiagonal) with the H0 column and load row; block-Jacobi LUs of J's
 diagonal blocks of b nodes with the border by a Schur complement (what the solver uses, b = 128).
 
-Run: ``python benchmarks/krylov_preconditioners.py [--nodes 1025 2049] [--rows FILE.json]``.
-Writes the ``krylov_preconditioners`` section of benchmarks/RESULTS.md.
+Run: ``python studies/krylov_preconditioners/krylov_preconditioners.py [--nodes 1025 2049]
+[--rows FILE.json]``.
+Writes the ``krylov_preconditioners`` section of studies/krylov_preconditioners/README.md.
 """
 
 from __future__ import annotations
@@ -31,7 +32,9 @@ import numpy as np  # noqa: E402
 import scipy.linalg as sla  # noqa: E402
 import scipy.sparse.linalg as spla  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parent))
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
 from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
@@ -166,7 +169,7 @@ def main(argv=None):
     body = "\n".join(
         [
             "## Preconditioners of the Krylov Newton directions "
-            "(`benchmarks/krylov_preconditioners.py`, issue 4)",
+            "(`krylov_preconditioners.py`, issue 4)",
             "",
             f"Machine: {machine()}. GMRES vectors (SciPy, restart 200) to ‖J d + F‖ ≤ {RTOL:g} ‖F‖ "
             "for the first Newton system of a transient step from the previous step's solution "
@@ -178,7 +181,7 @@ def main(argv=None):
             *rows,
         ]
     )
-    write_section("krylov_preconditioners", body)
+    write_section("krylov_preconditioners", body, README)
 
 
 if __name__ == "__main__":

@@ -22,11 +22,15 @@ paper fidelity's Φ̄ within 6.1 % over the baseline sweep):
    τm as the fluid traction (``shear="eyring_split"``; the paper's η* caps it at τ0), for k and TD/QS
    at the speeds of A-E.
 
-Writes the section ``load_convexity`` of benchmarks/RESULTS.md. Run (repository root), ~5 min:
-    python benchmarks/load_convexity.py
+Writes the section ``load_convexity`` of studies/load_exponent/README.md. Run (repository root),
+~5 min:
+    python studies/load_exponent/load_convexity.py
 """
 
 from __future__ import annotations
+
+import sys
+from pathlib import Path
 
 import jax
 
@@ -34,6 +38,11 @@ jax.config.update("jax_enable_x64", True)
 
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
+
 from _report import machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
@@ -267,7 +276,7 @@ def main():
         "|---|---|" + "---|" * len(RUNG_SPEEDS),
         *rung_table,
     ]
-    write_section("load_convexity", "\n".join(lines))
+    write_section("load_convexity", "\n".join(lines), README)
 
 
 if __name__ == "__main__":

@@ -23,10 +23,10 @@ their share of the load need not fall. This measures k both ways:
   one engagement, whose ratio is the ratio of Φ̄ at one speed (Φ̄ = mesh frequency × energy per
   engagement); failed steps counted at the mean of the converged ones.
 
-Writes the ``load_exponent`` section of benchmarks/RESULTS.md.
+Writes the ``load_exponent`` section of studies/load_exponent/README.md.
 
-Run: ``python benchmarks/load_exponent.py [--rows FILE]`` (``--rows`` keeps measured rows across
-runs).
+Run: ``python studies/load_exponent/load_exponent.py [--rows FILE]`` (``--rows`` keeps measured
+rows across runs).
 """
 
 from __future__ import annotations
@@ -41,7 +41,10 @@ jax.config.update("jax_enable_x64", True)
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parent))
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
+sys.path.insert(0, str(ROOT / "studies" / "mixed_thermal"))  # _path_contacts
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
 from _report import (  # noqa: E402
@@ -232,7 +235,7 @@ def main(argv=None):
             *path_rows,
         ]
     )
-    write_section("load_exponent", body)
+    write_section("load_exponent", body, README)
 
 
 if __name__ == "__main__":

@@ -3,21 +3,24 @@
 The paper's model has no mesh damping along the line of action (REFERENCE §1): its only mesh damping
 is the EHL film's, along the common tangent. Gear-dynamics models usually carry one (ζ of a few
 per cent: the film's squeeze and the teeth's material damping lumped), and the calibrated pair's
-back-flank rattle at 3850-4050 rpm (``benchmarks/attractor.py``) is an undamped vibro-impact regime.
+back-flank rattle at 3850-4050 rpm (``studies/attractor/attractor.py``) is an undamped vibro-impact
+regime.
 This benchmark runs the baseline sweep at ``Fidelity.fast()`` (calibrated pair, ground, 700 N m,
 90 °C, continuation, 500-4200 rpm every ``--step`` rpm) for several ζ and reports, per ζ: the speeds
 without a stable periodic orbit (status 6), the speeds whose teeth strike the back flanks and how
 hard, the DTE-RMS resonance peaks (among speeds without back strikes) and the largest DTE, Φ̄ and
 TD/QS at the points A-E (1700, 1800, 2550, 3300, 3500 rpm) and the sweep's wall time (compiled).
 
-Writes the section ``mesh_damping`` of benchmarks/RESULTS.md. Run (repository root):
-    python benchmarks/mesh_damping.py [--step 25] [--ratios 0 0.01 0.02 0.05 0.1]
+Writes the section ``mesh_damping`` of studies/mesh_damping/README.md. Run (repository root):
+    python studies/mesh_damping/mesh_damping.py [--step 25] [--ratios 0 0.01 0.02 0.05 0.1]
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import jax
 
@@ -26,6 +29,11 @@ jax.config.update("jax_enable_x64", True)
 import equinox as eqx  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
+
 from _report import bands, machine, write_section  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
@@ -91,7 +99,7 @@ def main(argv=None):
     qs_cells = " | ".join(f"{float(qs.power_loss[i]):.1f}" for i in at.values())
     body = "\n".join(
         [
-            "## A viscous mesh damping along the line of action (`benchmarks/mesh_damping.py`)",
+            "## A viscous mesh damping along the line of action (`mesh_damping.py`)",
             "",
             f"Machine: {machine()}.",
             "",
@@ -121,7 +129,7 @@ def main(argv=None):
             *point_rows,
         ]
     )
-    write_section("mesh_damping", body)
+    write_section("mesh_damping", body, README)
     print(body)
 
 

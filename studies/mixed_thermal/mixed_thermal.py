@@ -3,9 +3,11 @@ transient passage per step and per engagement.
 
 Contacts: the paper's pitch-point contact carrying the whole 700 N m load (ph ≈ 1.19 GPa), slide-to-roll
 ratio 0.3, at 500 and 3500 rpm, ground surfaces. Compile (first call) and run (median of repeats)
-are timed separately. Writes the ``mixed_thermal`` section of benchmarks/RESULTS.md.
+are timed separately. This default run is the performance benchmark: it writes the
+``mixed_thermal`` section of benchmarks/RESULTS.md. The options below are the study: each writes its
+section of studies/mixed_thermal/README.md.
 
-Run: ``python benchmarks/mixed_thermal.py [--repeats 3] [--steps 40]``
+Run: ``python studies/mixed_thermal/mixed_thermal.py [--repeats 3] [--steps 40]``
 
 ``--engagement``: one whole engagement actually marched (not extrapolated from a few steps): the
 ~900 grid-tied steps of the smooth, statistical thermal and deterministic passages at 500 and
@@ -63,10 +65,13 @@ jax.config.update("jax_enable_x64", True)
 
 import jax.numpy as jnp  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parent))
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
 from _report import (  # noqa: E402
+    RESULTS,
     ROWS_HELP,
     RowCache,
     compile_then_run,
@@ -261,7 +266,8 @@ def main(argv=None):
             print(prow[-1], flush=True)
     body = "\n".join(
         [
-            "## Thermal mixed EHL (issue 4)",
+            "## Thermal mixed EHL: what each switch costs a contact "
+            "(`studies/mixed_thermal/mixed_thermal.py`, issue 4)",
             "",
             f"Machine: {machine()}. Pitch-point contact, 700 N m, SRR 0.3, ground surfaces.",
             "Loss is per contact over the 20 mm face width.",
@@ -281,7 +287,7 @@ def main(argv=None):
             *prow,
         ]
     )
-    write_section("mixed_thermal", body)
+    write_section("mixed_thermal", body, RESULTS)  # a benchmark: benchmarks/RESULTS.md
 
 
 def _mib(nbytes):
@@ -405,7 +411,7 @@ def engagement():
             *rows,
         ]
     )
-    write_section("mixed_engagement", body)
+    write_section("mixed_engagement", body, README)
 
 
 def _converged_mean(sols, ok, field):
@@ -474,7 +480,7 @@ def engagement_grid(sizes):
             *rows,
         ]
     )
-    write_section("mixed_engagement_grid", body)
+    write_section("mixed_engagement_grid", body, README)
 
 
 def engagement_transport(cache):
@@ -544,7 +550,7 @@ def engagement_transport(cache):
             *rows,
         ]
     )
-    write_section("mixed_engagement_transport", body)
+    write_section("mixed_engagement_transport", body, README)
 
 
 def film_transport(cache):
@@ -613,7 +619,7 @@ def film_transport(cache):
             *rows,
         ]
     )
-    write_section("mixed_film_transport", body)
+    write_section("mixed_film_transport", body, README)
 
 
 def engagement_fine(
@@ -694,7 +700,7 @@ def engagement_fine(
             *rows,
         ]
     )
-    write_section("mixed_engagement_fine", body)
+    write_section("mixed_engagement_fine", body, README)
 
 
 def held_steps(sizes, k, thermal, cache, polished=False, krylov=False, sweeps=None):
@@ -777,7 +783,7 @@ def _write_held(rows, k):
             *rows,
         ]
     )
-    write_section("mixed_held_steps", body)
+    write_section("mixed_held_steps", body, README)
 
 
 def passage_iterations(k):
@@ -823,7 +829,7 @@ def passage_iterations(k):
             *rows,
         ]
     )
-    write_section("mixed_passage_iterations", body)
+    write_section("mixed_passage_iterations", body, README)
 
 
 if __name__ == "__main__":

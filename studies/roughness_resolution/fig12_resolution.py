@@ -11,8 +11,9 @@ band-limited by the stylus's short-wave cutoff λs (ISO 3274: 2.5 µm for λc = 
 given (the figures' own reproduction path, ``jaxgear.paper.field_contact``), with both profiles,
 unfiltered and at λs = 2.5 µm, on 513-4097 nodes.
 
-Run: ``python benchmarks/fig12_resolution.py [--nodes 513 1025 2049 4097] [--rpm 3500]
-[--rows FILE.json]``. Writes the ``fig12_resolution`` section of benchmarks/RESULTS.md.
+Run: ``python studies/roughness_resolution/fig12_resolution.py [--nodes 513 1025 2049 4097]
+[--rpm 3500] [--rows FILE.json]``. Writes the ``fig12_resolution`` section of
+studies/roughness_resolution/README.md.
 """
 
 from __future__ import annotations
@@ -25,6 +26,9 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 sys.path.insert(0, str(Path(__file__).parent))
 
 from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
@@ -89,7 +93,7 @@ def main(argv=None):
     ]
     body = "\n".join(
         [
-            "## The contact of Fig. 12 and R10 on finer grids (`benchmarks/fig12_resolution.py`, "
+            "## The contact of Fig. 12 and R10 on finer grids (`fig12_resolution.py`, "
             "issues 4 and 6)",
             "",
             f"Machine: {machine()}. The loaded contact nearest 17° (gear 1 roll angle "
@@ -108,7 +112,7 @@ def main(argv=None):
             *rows,
         ]
     )
-    write_section("fig12_resolution", body)
+    write_section("fig12_resolution", body, README)
 
 
 if __name__ == "__main__":

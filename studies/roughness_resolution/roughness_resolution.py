@@ -8,9 +8,9 @@ stylus instrument's short-wave cutoff λs (ISO 3274: 2.5 µm for ground gear fla
 This benchmark solves the same steady deterministic contact (the pitch point at speed E, iso-thermal)
 on each grid with both profiles and reports how the film, the asperity load and the loss move.
 
-Run: ``python benchmarks/roughness_resolution.py [--nodes 257 513 1025 2049] [--rpm 3500]
-[--polished] [--rows FILE.json]``.
-Writes the ``roughness_resolution`` section of benchmarks/RESULTS.md.
+Run: ``python studies/roughness_resolution/roughness_resolution.py [--nodes 257 513 1025 2049]
+[--rpm 3500] [--polished] [--rows FILE.json]``.
+Writes the ``roughness_resolution`` section of studies/roughness_resolution/README.md.
 """
 
 from __future__ import annotations
@@ -27,7 +27,9 @@ jax.config.update("jax_enable_x64", True)
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parent))
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
 from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
@@ -152,7 +154,7 @@ def main(argv=None):
     body = "\n".join(
         [
             "## Roughness resolution: the deterministic film on finer grids "
-            "(`benchmarks/roughness_resolution.py`, issue 4)",
+            "(`roughness_resolution.py`, issue 4)",
             "",
             f"Machine: {machine()}. Pitch-point contact, {args.rpm:.0f} rpm, 700 N m, SRR 0.3, "
             "ground (Rq 0.40 µm per surface, ℓ 20 µm, seed 0; polished rows: Rq 0.05 µm), "
@@ -169,7 +171,7 @@ def main(argv=None):
             *rows,
         ]
     )
-    write_section("roughness_resolution", body)
+    write_section("roughness_resolution", body, README)
 
 
 if __name__ == "__main__":

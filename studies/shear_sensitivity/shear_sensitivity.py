@@ -4,12 +4,13 @@ The paper's η* = η/cosh(τm/τ0) keeps the fluid shear stress below τ0; the e
 τ = τ0 asinh(η us/(τ0 h)) does not. REFERENCE §4 asks for both and the sensitivity. This runs the
 paper fidelity (thermal, statistical mixed, transient; 32 positions × 257 nodes) at the nominal
 speeds of the points A-E (``figures.NOMINAL_POINTS_RPM``), quasi-static and tribo-dynamic,
-with each shear law and the same τ0 (5 MPa, the preset's), and writes its section of RESULTS.md.
+with each shear law and the same τ0 (5 MPa, the preset's), and writes its section of
+studies/shear_sensitivity/README.md.
 
-Run: ``python benchmarks/shear_sensitivity.py [--quick | --trends]`` (``--quick``: quasi-static only,
-points B and E; ``--trends``: the paper's trends R5-R9 and R3 at 3300 rpm under each law, section
-``shear_trends``; ``--trends --density-product 0.08``: the same at another Greenwood-Tripp nβσ, with
-R3 at the speeds of A-E, section ``shear_trends_asperity``). Full: about 10 min on 2 cores, the
+Run: ``python studies/shear_sensitivity/shear_sensitivity.py [--quick | --trends]`` (``--quick``:
+quasi-static only, points B and E; ``--trends``: the paper's trends R5-R9 and R3 at 3300 rpm
+under each law, section ``shear_trends``; ``--trends --density-product 0.08``: the same at another
+Greenwood-Tripp nβσ, with R3 at the speeds of A-E, section ``shear_trends_asperity``). Full: about 10 min on 2 cores, the
 trends about 20 min; ``--limiting``: where a limiting shear stress τL = Λ p binds, section
 ``shear_limiting``, about 10 min. Run one JAX process at a time on 2 cores: two at once slowed each point here
 by 10-40× (thread pools contending), not 2×.
@@ -24,6 +25,10 @@ from pathlib import Path
 import jax
 
 jax.config.update("jax_enable_x64", True)
+
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 
 from _report import effective_friction, machine, write_section  # noqa: E402
 
@@ -91,7 +96,7 @@ def main(quick: bool = False):
                     flush=True,
                 )
     lines = [
-        "## Fluid shear law: the paper's η* against exact Eyring (`benchmarks/shear_sensitivity.py`)",
+        "## Fluid shear law: the paper's η* against exact Eyring (`shear_sensitivity.py`)",
         "",
         f"Machine: {machine()}. Paper fidelity (thermal, statistical mixed, transient, 32 positions "
         "× 257 nodes), calibrated pair, ground, 700 N m, 90 °C, τ0 = 5 MPa; the points at their "
@@ -115,7 +120,7 @@ def main(quick: bool = False):
     ]
     if len(dynamics) == 2:
         lines += ["", *_r3_table(rows, points)]
-    write_section("shear_sensitivity", "\n".join(lines))
+    write_section("shear_sensitivity", "\n".join(lines), README)
 
 
 #: (label, overrides of the baseline) for R5-R9: iso-thermal, 60 °C inlet, 1500 N m, polished.
@@ -177,7 +182,7 @@ def trends(density_product=None):
 
     loss = {(sh, lab, rpm): (tot, roll, eff, st) for sh, lab, rpm, tot, roll, eff, st in rows}
     lines = [
-        "## Fluid shear law and the paper's trends R5-R9 (`benchmarks/shear_sensitivity.py --trends`)",
+        "## Fluid shear law and the paper's trends R5-R9 (`shear_sensitivity.py --trends`)",
         "",
         f"Machine: {machine()}. Tribo-dynamic paper fidelity (thermal unless iso-thermal, "
         "statistical mixed, transient; 32 positions × 257 nodes), calibrated pair, ground, "
@@ -232,13 +237,13 @@ def trends(density_product=None):
         "E (the peak), nearly equal at C.",
     ]
     if density_product is None:
-        write_section("shear_trends", "\n".join(lines))
+        write_section("shear_trends", "\n".join(lines), README)
     else:
         lines[0] = (
-            f"## The same at nβσ = {density_product} (`benchmarks/shear_sensitivity.py --trends "
+            f"## The same at nβσ = {density_product} (`shear_sensitivity.py --trends "
             f"--density-product {density_product}`)"
         )
-        write_section("shear_trends_asperity", "\n".join(lines))
+        write_section("shear_trends_asperity", "\n".join(lines), README)
 
 
 LIMITS = (0.1, 0.05, 0.03, 0.02, 0.01, 0.005)
@@ -265,7 +270,7 @@ def limiting():
              (1500.0, 4200.0, 363.15), (700.0, 1000.0, 333.15), (700.0, 4200.0, 333.15)]  # fmt: skip
     lines = [
         "## A limiting shear stress τL = Λ p under the Eyring stress "
-        "(`benchmarks/shear_sensitivity.py --limiting`)",
+        "(`shear_sensitivity.py --limiting`)",
         "",
         f"Machine: {machine()}. Closed-form contact (`ehl_formula`, smooth surfaces, "
         '`shear="eyring_split"`), pitch contact carrying the whole load, slide-to-roll 0.3: the '
@@ -325,7 +330,7 @@ def limiting():
             f"| {'none' if limit is None else limit} | {base} | {col('iso-thermal')} | "
             f"{col('60 °C')} | {col('1500 N m')} | {', '.join(map(str, sorted(stats)))} |"
         )
-    write_section("shear_limiting", "\n".join(lines))
+    write_section("shear_limiting", "\n".join(lines), README)
 
 
 if __name__ == "__main__":

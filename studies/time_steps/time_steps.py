@@ -13,9 +13,10 @@ deterministic engagement (`mixed_engagement`); each with the Eulerian wedge and 
 along the characteristics (`EHLModel.transport`); and, for the polished film by BDF2 at C = 0.5 on
 2049 nodes, the Newton tolerance (`EHLModel.tolerance`) from 1e-7 to 1e-3. Reported: the loss per width at the window's end (the roughness then
 stands at the same place in every run), the mean over the window's second half, p_max and h_min
-at the end, and the cost. Writes the ``mixed_time_steps`` section of benchmarks/RESULTS.md.
+at the end, and the cost. Writes the ``mixed_time_steps`` section of studies/time_steps/README.md.
 
-Run: ``python benchmarks/time_steps.py [--rows FILE]`` (``--rows`` keeps measured rows across runs).
+Run: ``python studies/time_steps/time_steps.py [--rows FILE]`` (``--rows`` keeps measured rows
+across runs).
 """
 
 from __future__ import annotations
@@ -30,7 +31,9 @@ jax.config.update("jax_enable_x64", True)
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parent))
+ROOT = Path(__file__).resolve().parents[2]
+README = Path(__file__).with_name("README.md")  # this study's sections
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
 from _report import (  # noqa: E402
@@ -175,7 +178,7 @@ def main(argv=None):
             *table,
         ]
     )
-    write_section("mixed_time_steps", body)
+    write_section("mixed_time_steps", body, README)
 
 
 if __name__ == "__main__":
