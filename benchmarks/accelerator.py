@@ -223,6 +223,9 @@ def main(argv=None):
 def report(record, other=None) -> str:
     """The markdown section: ``record``'s table (and ``other``'s), and Φ̄ differences between them."""
     lines = [
+        "## Accelerators: the fast() sweep and the EHL kernel on a GPU and on the CPU "
+        "(`benchmarks/accelerator.py`)",
+        "",
         "Sweeps: baseline speeds 500-4200 rpm every 25 rpm, calibrated pair, ground, 700 N m, "
         "90 °C; compile = first call − a later call (the sweeps: one call on speeds shifted by "
         "0.001 rpm; the EHL kernel: the median of 3).",

@@ -141,6 +141,9 @@ def main():
         for name, root in trees.items():
             results[name]["jaxgear_run_s"] = jaxgear_run(root)
     lines = [
+        "## Compilation: `simulate` and its reverse gradient against the code before "
+        "(`benchmarks/compile.py`)",
+        "",
         f"Machine: {machine()}. `Fidelity.fast()`, calibrated pair, ground, 700 N m, 2500 rpm; "
         "compilation cache off, each tree in a fresh process, both in this run.",
         "",

@@ -59,6 +59,20 @@ ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_JSON = ROOT / "jaxgear" / "data" / "fidelity_errors.json"
 DEFAULT_FIGURE = ROOT / "docs" / "figures" / "fidelity_pareto.png"
 
+#: Where the shipped measured-error table comes from and who reads it: the one place this is
+#: written down (the section's first paragraph).
+PROVENANCE = (
+    "This run also writes `jaxgear/data/fidelity_errors.json`, the measured-error table shipped "
+    "with the package: the rungs, scenarios, reference, convergence studies, machine and date of "
+    "this section (`--json PATH` writes it elsewhere; `--smoke`, a pipeline check, writes it too "
+    "unless `--json` points elsewhere). `Fidelity.auto` and `choose_fidelity` read it "
+    "(`jaxgear/fidelity/choose.py`, `load_error_table`, which refuses a table of another "
+    "`INDICATOR_VERSION`); `benchmarks/coupling_trade.py` takes the reference's results and run "
+    "times from it, `benchmarks/fast_vs_paper.py` its run time per point. Regenerate both after a change to the physics, the "
+    "rungs or the indicators: `PYTHONPATH=. python benchmarks/fidelity_trade.py --quick --cache "
+    "/tmp/fidelity_cache.json`."
+)
+
 #: Resolution levels of the ladder. "default" is ``Fidelity()``'s resolution.
 LEVELS = {
     "coarse": {"n_positions": 24, "n_nodes": 65, "steps_per_period": 32},
@@ -518,6 +532,8 @@ def write_report(table, studies, figure_path, wall, quick, write=True):
     scen_names = [s for s in table["scenarios"] if table["scenarios"][s]["reference_converged"]]
     lines = [
         f"## Fidelity ladder: error against time (`benchmarks/fidelity_trade.py{' --quick' if quick else ''}`, issue 7)",
+        "",
+        PROVENANCE,
         "",
         f"Machine: {table['machine']}; load average at the end {table['load_average']} (the 2 cores "
         "were shared with other engineers' jobs: run times are upper bounds, compare them within this "

@@ -201,6 +201,9 @@ def main():
         rows.append((float(rpm), *d))
 
     lines = [
+        "## The contact loss is concave in the tooth load: what it does to R3 and R7 "
+        "(`load_convexity.py`)",
+        "",
         f"Machine: {machine()}. `Fidelity.fast()` (ehl_formula: Pan-Hamrock film, Greenwood-Tripp "
         "asperity load, paper η* traction, Goksem-Hargreaves rolling), calibrated pair, ground, "
         "700 N m, 90 °C.",
