@@ -2,9 +2,9 @@
 in the film (issues 4 and 6).
 
 The coupled model's R3 at point E and R7's efficiency (REFERENCE §7) turn on the load exponent
-k = d ln Φ/d ln W of a contact's loss (README, known open points: with the statistical
+k = d ln Φ/d ln W of a contact's loss (docs/open_points.md: with the statistical
 Greenwood-Tripp contact k ≈ 0.6, concave, and a dynamic load swing lowers the cycle's mean loss;
-RESULTS ``load_convexity``). Greenwood-Tripp's asperity pressure is a function of the film
+``load_convexity.py`` beside this script). Greenwood-Tripp's asperity pressure is a function of the film
 h/σ alone, and the film hardly depends on the load, so the asperity load grows with the Hertz
 width, as √W. With the profiles in the film (the paper's measured profiles; here the synthetic
 ground preset, unfiltered) the asperities inside the Hertz zone are flattened by the pressure and
@@ -19,7 +19,7 @@ their share of the load need not fall. This measures k both ways:
   contact's cells are 1.46× wider (coarser cells make more asperity contact), and the deterministic
   1500 N m contact is solved again on 377 and 753 nodes, the 700 N m contact's cells on 257 and 513;
 - along the path: one whole engagement (quasi-static load sharing of the calibrated pair, 257
-  nodes, thermal, as RESULTS ``mixed_engagement``) at 700 and 1500 N m: the friction energy of
+  nodes, thermal, as ``mixed_engagement`` in studies/mixed_thermal) at 700 and 1500 N m: the friction energy of
   one engagement, whose ratio is the ratio of Φ̄ at one speed (Φ̄ = mesh frequency × energy per
   engagement); failed steps counted at the mean of the converged ones.
 

@@ -142,7 +142,7 @@ def trends(density_product=None):
     resonance, which sits at about 3375 rpm: where D falls relative to this model's peak).
 
     ``density_product``: the Greenwood-Tripp nβσ instead of the default 0.05 (0.08 brings the
-    quasi-static level to the paper's, ``benchmarks/friction_sensitivity.py``); then the paper's
+    quasi-static level to the paper's, ``studies/friction_sensitivity``); then the paper's
     η* and the split law only (the exact law equals the split one within 0.2 % here), R3 at the
     speeds of A-E and 3300 rpm, and the section ``shear_trends_asperity``."""
     extra = {} if density_product is None else {"asperity_density_product": density_product}

@@ -9,7 +9,7 @@ polished surfaces filtered at λs = 2.5 µm (a full film: `figures.field_surface
 steady start over the same rolling distance (40 cells of the 2049-node grid, 31 µm) with
 Δt = C Δx/ur, C the Courant number, by backward Euler and by BDF2 (`EHLModel.time_scheme`), on
 1025, 2049 and 4097 nodes; and the ground surfaces (unfiltered) on the 257 nodes of the
-deterministic engagement (`mixed_engagement`); each with the Eulerian wedge and squeeze terms and
+deterministic engagement (`mixed_engagement`, studies/mixed_thermal); each with the Eulerian wedge and squeeze terms and
 along the characteristics (`EHLModel.transport`); and, for the polished film by BDF2 at C = 0.5 on
 2049 nodes, the Newton tolerance (`EHLModel.tolerance`) from 1e-7 to 1e-3. Reported: the loss per width at the window's end (the roughness then
 stands at the same place in every run), the mean over the window's second half, p_max and h_min
