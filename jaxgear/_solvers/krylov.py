@@ -5,7 +5,7 @@ direction costs a solve of (I − ∂T/∂x) v = ∂T/∂θ·dθ, one JVP of the
 vector. ``lineax.GMRES`` checks convergence only between restart cycles and ends only when two
 cycles agree, so it costs at least two full cycles (41 JVPs at restart 20) even where T contracts so
 strongly that a handful of Krylov vectors solve the system: 85 % of the gradient's cost at
-``Fidelity.fast()`` (benchmarks/RESULTS.md, end_to_end). This GMRES tracks the residual of its
+``Fidelity.fast()``. This GMRES tracks the residual of its
 least-squares problem at every Arnoldi step (Givens rotations) and stops there; each cycle ends with
 the true residual b − A x, so a cycle cannot report convergence that rounding has faked.
 

@@ -23,7 +23,7 @@ cell per step (EHL_NOTES "Transient"); :func:`grid_time_step` gives it. Backward
 order in Δt: halving Δt halves the time-discretisation error; BDF2 is second order (both tested).
 A roughness whose shortest wavelength spans a few cells passes a node in a few such steps, so with
 the Eulerian terms a rough film's friction needs Δt below Δx/ur; along the characteristics it
-does not, up to a few Δx/ur (RESULTS ``mixed_time_steps``).
+does not, up to a few Δx/ur (studies/time_steps).
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ def grid_time_step(contact: LineContact, lubricant: Lubricant, model: EHLModel):
 
     It ties the step to the grid but does not resolve a roughness of a few cells' wavelength in
     time: a deterministic rough film's friction wants a fraction of it, by BDF2
-    (``EHLModel(time_scheme="bdf2")``; RESULTS ``mixed_time_steps``: Δt/2 within 6 % of the
+    (``EHLModel(time_scheme="bdf2")``; studies/time_steps: Δt/2 within 6 % of the
     Δt → 0 loss on the polished film at 2049 nodes, backward Euler at Δt 36 % above)."""
     x = _grid_positions(model, contact, lubricant)
     return (x[1] - x[0]) / contact.rolling_velocity

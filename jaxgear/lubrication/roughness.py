@@ -21,8 +21,7 @@ profile filter of ISO 16610-21, amplitude transmission exp(−π (α λs/λ)²),
 λ = λs) to the synthetic profile, whose rms slope then no longer depends on a sampling finer than
 ~λs/10. An EHL grid needs more still: under-resolved roughness makes asperity contact a resolved
 film does not have, and a waviness is resolved from ~13 nodes a wavelength
-(``benchmarks/roughness_resolution.py``). The default (None) keeps the unfiltered profile, as the
-results in the README were computed with.
+(studies/roughness_resolution). The default (None) keeps the unfiltered profile.
 """
 
 from __future__ import annotations

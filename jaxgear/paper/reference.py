@@ -42,12 +42,11 @@ FIELD_ROLL_ANGLE_DEG = {7: 25.0, 12: 17.0}
 #: no asperity pressures to show. The profiles are the runs' synthetic surfaces as a stylus
 #: instrument measures them (``field_surfaces``): band-limited at λs = 2.5 µm, the ISO 3274 cutoff
 #: for λc = 0.8 mm (the paper put measured profiles in its film). Unfiltered, the exponential
-#: autocorrelation has no finest scale and the film moves with the grid (benchmarks/RESULTS.md,
-#: ``roughness_resolution``). Filtered, this contact settles by 2049 nodes (Δx ≈ 0.5 µm at 17°):
+#: autocorrelation has no finest scale and the film moves with the grid (studies/roughness_resolution). Filtered, this contact settles by 2049 nodes (Δx ≈ 0.5 µm at 17°):
 #: polished p_max and h_min within 0.5 % of 4097 nodes, ground p_max within 2 % of 1025 nodes
-#: (``fig12_resolution``). The ground film's asperity load is what still moves (the > 3 GPa peaks
+#: (studies/roughness_resolution, ``fig12_resolution``). The ground film's asperity load is what still moves (the > 3 GPa peaks
 #: are micro-EHL pressure in a film 26 nm thin at its thinnest), as at the pitch contact, where
-#: that film needs Δx ≲ λs/13 (``roughness_resolution``). Steady and iso-thermal: the thermal
+#: that film needs Δx ≲ λs/13 (studies/roughness_resolution). Steady and iso-thermal: the thermal
 #: deterministic film's Poiseuille heat is not grid-converged (docs/limitations.md,
 #: deterministic roughness); and the roughness is frozen at the instant (moving roughness:
 #: ``solve_ehl_passage``).

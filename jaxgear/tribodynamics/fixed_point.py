@@ -284,7 +284,7 @@ def tribo_dynamic_fixed_point(pair, lubricant, surfaces, op, fidelity, mesh, war
     # One JVP of ``step`` per Krylov vector and direction. T contracts strongly where the fixed point
     # converges in a few iterations, and then a few vectors solve the system (5 at 2500 rpm, fast());
     # lineax's GMRES(20) spent two whole cycles (41 JVPs) there: the gradient cost 6.4× the forward
-    # instead of 3.0× (benchmarks/RESULTS.md, end_to_end).
+    # instead of 3.0×.
     # A failed implicit solve (a singular I − ∂T/∂x, a non-finite right-hand side) gives NaN
     # derivatives, never an exception from inside the transformation.
     adjoint = NaNImplicitAdjoint(

@@ -234,7 +234,7 @@ class EHLModel(eqx.Module):
             matrix. The same discrete system to the same tolerance (solutions within 1e-6);
             coarser levels of the grid sequence keep the dense LU, and the implicit derivative
             keeps its dense rule. A deterministic passage step costs 2.2-3.5× less on 1025-2049
-            nodes (benchmarks/RESULTS.md, ``mixed_held_steps``).
+            nodes (studies/mixed_thermal, ``mixed_held_steps``).
         time_scheme: the squeeze term ∂(ρh)/∂t of a transient passage (``solve_ehl_passage``).
             "backward_euler" (default): first order. "bdf2": second-order backward differences
             on variable steps (the first transient step, and a step after a failed one, backward
@@ -245,7 +245,7 @@ class EHLModel(eqx.Module):
             start from cold has left the contact (a flux switched on heats the solids as √t) and
             with tight ``thermal_rtol``. A deterministic rough film's loss needs it: on the
             polished film at Δt = Δx/ur backward Euler is 36 % above the Δt → 0 limit, BDF2 at
-            Δx/(2 ur) 6 % (benchmarks/RESULTS.md, ``mixed_time_steps``).
+            Δx/(2 ur) 6 % (studies/time_steps).
         transport: how a transient step discretises the film's transport u_m ∂(ρh)/∂x + ∂(ρh)/∂t.
             "eulerian" (default): the upwind wedge term plus the squeeze term at the node.
             "characteristic": the two together as the material derivative D(ρh)/Dt along the
@@ -257,8 +257,7 @@ class EHLModel(eqx.Module):
             wedge (first- or second-order upwind at Δt = Δx/ur). The Eulerian terms instead damp
             and lag a roughness a few cells long, and the film answers that with pressure flow,
             so with Poiseuille heat: on the polished film the characteristic loss agrees within
-            2 % over Δt = 0.5-4 Δx/ur, the Eulerian ones vary 2.5× (benchmarks/RESULTS.md,
-            ``mixed_time_steps``). Steady solves have no squeeze term and ignore it. Use it with
+            2 % over Δt = 0.5-4 Δx/ur, the Eulerian ones vary 2.5× (studies/time_steps). Steady solves have no squeeze term and ignore it. Use it with
             BDF2 and steps of a few cells: for a steady film it is the upwind difference over the
             C cells a step spans, so a step must stay short against the outlet constriction
             (C Δx ≲ 0.05 b keeps the minimum film within 2 %); the coupled model's transient rung,

@@ -44,7 +44,7 @@ def solve_ehl(
             where the film closes (Hu-Zhu unified Reynolds, paper Eq. 4b/4c) and boundary friction
             μb p there. The grid must resolve the roughness: under-resolved features make
             asperity contact a resolved film does not have (a waviness needs ≳ 13 nodes a
-            wavelength; ``benchmarks/roughness_resolution.py``).
+            wavelength; studies/roughness_resolution).
             A deep mixed deterministic film whose direct solve fails (500 rpm, ground, 513 nodes
             and finer) is reached by pseudo-transient continuation (``model.pseudo_transient_steps``).
         initial: a previous EHLSolution to warm-start from (any contact; its p(x) is interpolated
