@@ -68,3 +68,28 @@ def test_no_module_is_too_long():
     assert not long, f"modules over {MAX_MODULE_LINES} lines: " + ", ".join(
         f"{name} ({n} lines)" for name, n in sorted(long.items())
     )
+
+
+REPO = ROOT.parent
+MAX_README_LINES = 150
+
+
+def test_readme_is_a_users_page():
+    """The README stays a user's page: at most ``MAX_README_LINES`` lines, dates only in a
+    "measured on" note, and its test command is the one CI runs (``.ci/run``)."""
+    readme = REPO / "README.md"
+    if not readme.exists():  # an installed package without its repository
+        import pytest
+
+        pytest.skip("README.md is not beside the package")
+    lines = readme.read_text(encoding="utf-8").splitlines()
+    assert len(lines) <= MAX_README_LINES, f"README.md has {len(lines)} lines"
+    dated = [
+        f"README.md:{n}: {line.strip()}"
+        for n, line in enumerate(lines, start=1)
+        if ISO_DATE.search(line) and "measured on" not in line
+    ]
+    assert not dated, "dates outside a 'measured on' note:\n" + "\n".join(dated)
+    ci = (REPO / ".ci" / "run").read_text(encoding="utf-8")
+    command = '.venv/bin/pip install -e ".[test]" && .venv/bin/python -m pytest'
+    assert command in ci and command in "\n".join(lines)

@@ -169,7 +169,7 @@ def iso_single_stiffness(pair: GearPair, basic_rack_dedendum=ISO_BASIC_RACK_DEDE
     """ISO 6336-1 method B single stiffness c' per unit face width (N/m per m, i.e. Pa).
 
     c' = c'_th C_M C_R C_B with c'_th = 1/q' (solid disks C_R = 1, C_M = 0.8,
-    C_B = [1 + 0.5(1.2 − h_fP/m)][1 − 0.02(20° − α)], h_fP/m clipped to ISO's 1.2-1.4).
+    ``C_B = [1 + 0.5(1.2 − h_fP/m)][1 − 0.02(20° − α)]``, h_fP/m clipped to ISO's 1.2-1.4).
 
     ``basic_rack_dedendum`` is h_fP/m of the basic rack profile the rating refers to (default ISO
     53's 1.25). It is not the pair's ``dedendum_coefficient``, which places the root circle: the

@@ -94,7 +94,7 @@ def barus_log_pressure_factor(pressure, alpha):
 def dowson_higginson_density(pressure, temperature, rho_ref, t_ref, thermal_expansion):
     """Dowson-Higginson density with linear thermal expansion, kg/m³.
 
-    ρ = ρ_ref [1 + 0.6e-9 p/(1 + 1.7e-9 p)] [1 − ε (T − T_ref)], p in Pa, T in K (REFERENCE §4).
+    ``ρ = ρ_ref [1 + 0.6e-9 p/(1 + 1.7e-9 p)] [1 − ε (T − T_ref)]``, p in Pa, T in K (REFERENCE §4).
     """
     p = _clip_pressure(pressure)
     return (

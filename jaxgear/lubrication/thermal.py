@@ -143,10 +143,10 @@ def surface_temperature_rise(
 def uniform_source_kernel(n: int, dx) -> tuple[Float[Array, " n"], Float[Array, " n"]]:
     """Toeplitz kernel of :func:`moving_source_matrices` on a uniform grid of spacing ``dx`` (m^½).
 
-    On a uniform grid K[0][i, j] = far[i − j] + near[i − j] (0 for j > i): the far-end hat weight
+    On a uniform grid ``K[0][i, j] = far[i − j] + near[i − j]`` (0 for j > i): the far-end hat weight
     of segment j (s from (m − 1)Δ to mΔ, m = i − j ≥ 1) plus the near-end weight of segment j − 1
     (s from mΔ to (m + 1)Δ), with the cancellation-free closed forms of the matrix. Column 0 has no
-    segment −1 (no flux outside the grid): K[0][i, 0] = far[i].
+    segment −1 (no flux outside the grid): ``K[0][i, 0] = far[i]``.
 
     Returns:
         (far, near), each shape (n,).
