@@ -1,4 +1,4 @@
-"""Compile and run time of the dynamic steady state (issue 5): one speed, and the paper's 149-speed
+"""Compile and run time of the dynamic steady state: one speed, and the paper's 149-speed
 sweep (500 to 4200 rpm in 25 rpm steps) in parallel (vmap) and continuation (lax.scan) modes, on the
 calibrated preset at 700 N m; plus the step-count convergence check behind the default options.
 Targets (2-core CPU): ≤ 50 ms per speed compiled; the whole sweep ≤ 5 s after compilation.
@@ -63,7 +63,7 @@ def main() -> None:
     bad_c = int(np.sum(np.asarray(sw_c.status) != 0))
     load = os.getloadavg()[0]
     lines = [
-        "## Dynamics (`benchmarks/dynamics.py`, issue 5)",
+        "## Dynamics (`benchmarks/dynamics.py`)",
         "",
         f"Machine: {machine()}; load average at the end {load:.1f} (the 2 cores were shared with",
         "other engineers' jobs, so run times are upper bounds).",

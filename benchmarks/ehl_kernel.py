@@ -1,4 +1,4 @@
-"""Benchmark of the EHL line-contact kernel (issue 3): compile and run times, Newton iterations and
+"""Benchmark of the EHL line-contact kernel: compile and run times, Newton iterations and
 grid
 error, cold and warm-started, single and vmapped, plus the implicit-gradient cost.
 
@@ -257,7 +257,7 @@ def write_results(
         f"(ratio {g_run / f_run:.2f}; value_and_grad {ms(vg_run)} ms, ratio {vg_run / f_run:.2f}); "
         f"grad compile {g_compile:.1f} s. Target ≤ 3×.",
         "- Reference point (not re-measured here): a straightforward NumPy dense-Newton solver with grid "  # noqa: E501
-        "sequencing takes about 100 ms at N = 257 and 2 s at N = 1025 on this class of CPU (issue 3).",  # noqa: E501
+        "sequencing takes about 100 ms at N = 257 and 2 s at N = 1025 on this class of CPU.",  # noqa: E501
         "<!-- END ehl_kernel -->",
     ]
     section = "\n".join(lines)

@@ -164,7 +164,7 @@ def main(argv=None):
     body = "\n".join(
         [
             "## End to end: `jaxgear run`, sweeps, one paper-fidelity speed, gradients "
-            "(`benchmarks/end_to_end.py`, issue 6)",
+            "(`benchmarks/end_to_end.py`)",
             "",
             f"Machine: {machine()}. Calibrated pair, Mil-L-23699, ground, 700 N m, 90 °C.",
             "",

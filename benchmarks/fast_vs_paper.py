@@ -61,7 +61,7 @@ def main(argv=None):
     fast_point = fast_again / len(speeds)
     lines = [
         "## Fidelity.fast() against Fidelity.paper() over the baseline sweep "
-        "(`benchmarks/fast_vs_paper.py`, issue 7)",
+        "(`benchmarks/fast_vs_paper.py`)",
         "",
         f"Machine: {machine()}. Calibrated pair, ground, 700 N m, 90 °C, 500-4200 rpm every "
         f"{args.step:g} rpm, continuation. fast(): {jg.Fidelity.fast().friction} friction, "

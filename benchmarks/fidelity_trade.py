@@ -531,7 +531,7 @@ def write_report(table, studies, figure_path, wall, quick, write=True):
     ref = table["reference"]
     scen_names = [s for s in table["scenarios"] if table["scenarios"][s]["reference_converged"]]
     lines = [
-        f"## Fidelity ladder: error against time (`benchmarks/fidelity_trade.py{' --quick' if quick else ''}`, issue 7)",
+        f"## Fidelity ladder: error against time (`benchmarks/fidelity_trade.py{' --quick' if quick else ''}`)",
         "",
         PROVENANCE,
         "",

@@ -27,7 +27,7 @@ def main() -> None:
                 f"  (new torque {run_new * 1e3:6.2f} ms)"
             )
     lines = [
-        "## Mesh cycle (`benchmarks/mesh.py`, issue 2)",
+        "## Mesh cycle (`benchmarks/mesh.py`)",
         "",
         f"Machine: {machine()}.",
         "",

@@ -1,4 +1,4 @@
-"""Cost of one operating point at the paper fidelity (issue 6): point E of REFERENCE §7 (3500 rpm,
+"""Cost of one operating point at the paper fidelity: point E of REFERENCE §7 (3500 rpm,
 ground, 700 N m, 90 °C), quasi-static and tribo-dynamic, plus the smooth-EHL rung for comparison.
 
 Run: ``python benchmarks/paper_point.py`` (writes its section of benchmarks/RESULTS.md).

@@ -1,4 +1,4 @@
-"""Why ``EHLModel(linear_solver="krylov")`` preconditions as it does (issue 4): GMRES vectors to
+"""Why ``EHLModel(linear_solver="krylov")`` preconditions as it does: GMRES vectors to
 solve one Newton system of a transient deterministic step, with each candidate preconditioner.
 
 The system: the first Newton iteration of the second step of a passage of the held pitch contact
@@ -169,7 +169,7 @@ def main(argv=None):
     body = "\n".join(
         [
             "## Preconditioners of the Krylov Newton directions "
-            "(`krylov_preconditioners.py`, issue 4)",
+            "(`krylov_preconditioners.py`)",
             "",
             f"Machine: {machine()}. GMRES vectors (SciPy, restart 200) to ‖J d + F‖ ≤ {RTOL:g} ‖F‖ "
             "for the first Newton system of a transient step from the previous step's solution "

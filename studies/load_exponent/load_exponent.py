@@ -1,5 +1,5 @@
 """How one contact's loss grows with its load: the statistical asperity model against the roughness
-in the film (issues 4 and 6).
+in the film.
 
 The coupled model's R3 at point E and R7's efficiency (REFERENCE §7) turn on the load exponent
 k = d ln Φ/d ln W of a contact's loss (docs/open_points.md: with the statistical
@@ -199,7 +199,7 @@ def main(argv=None):
     body = "\n".join(
         [
             "## A contact's loss against its load: statistical against deterministic asperity "
-            "contact (`load_exponent.py`, issues 4 and 6)",
+            "contact (`load_exponent.py`)",
             "",
             f"Machine: {machine()}. Ground preset (unfiltered), Mil-L-23699, 90 °C inlet. Held: "
             "the pitch-point contact (SRR 0.3, 3500 rpm, iso-thermal) at the loads of 700 and "

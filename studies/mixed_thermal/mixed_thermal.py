@@ -1,4 +1,4 @@
-"""Benchmark of the thermal mixed EHL solve (issue 4): what each switch costs per contact, and the
+"""Benchmark of the thermal mixed EHL solve: what each switch costs per contact, and the
 transient passage per step and per engagement.
 
 Contacts: the paper's pitch-point contact carrying the whole 700 N m load (ph ≈ 1.19 GPa), slide-to-roll
@@ -267,7 +267,7 @@ def main(argv=None):
     body = "\n".join(
         [
             "## Thermal mixed EHL: what each switch costs a contact "
-            "(`studies/mixed_thermal/mixed_thermal.py`, issue 4)",
+            "(`studies/mixed_thermal/mixed_thermal.py`)",
             "",
             f"Machine: {machine()}. Pitch-point contact, 700 N m, SRR 0.3, ground surfaces.",
             "Loss is per contact over the 20 mm face width.",
@@ -392,7 +392,7 @@ def engagement():
             print(rows[-1], flush=True)
     body = "\n".join(
         [
-            "## One whole engagement, marched, and its memory (`--engagement`, issue 4 Reach)",
+            "## One whole engagement, marched, and its memory (`--engagement`)",
             "",
             f"Machine: {machine()}. Pitch-point contact, 700 N m, SRR 0.3, ground surfaces, 257 "
             "nodes, Δt = Δx/ur of the pitch-point contact for the time the contact takes to cross "
@@ -466,7 +466,7 @@ def engagement_grid(sizes):
             print(rows[-1], flush=True)
     body = "\n".join(
         [
-            "## The deterministic engagement on finer grids (`--engagement-grid`, issue 4)",
+            "## The deterministic engagement on finer grids (`--engagement-grid`)",
             "",
             f"Machine: {machine()}. One engagement along the path of contact (as "
             "`mixed_engagement`), ground, 700 N m, iso-thermal, the default `EHLModel` "
@@ -532,7 +532,7 @@ def engagement_transport(cache):
             rows.append(cache.get(key, lambda label=label, kw=kw, rpm=rpm: measure(label, kw, rpm)))
     body = "\n".join(
         [
-            "## The ground engagement along the characteristics (`--engagement-transport`, issue 4)",
+            "## The ground engagement along the characteristics (`--engagement-transport`)",
             "",
             f"Machine: {machine()}. One engagement along the path of contact (as "
             "`mixed_engagement`: ground, 700 N m, 257 nodes, Δt = Δx/ur of the pitch-point "
@@ -602,7 +602,7 @@ def film_transport(cache):
                 )
     body = "\n".join(
         [
-            "## Smooth and statistical films under each transport (`--film-transport`, issue 4)",
+            "## Smooth and statistical films under each transport (`--film-transport`)",
             "",
             f"Machine: {machine()}. One thermal engagement along the path of contact (as "
             "`mixed_engagement`: 700 N m, 257 nodes, Δt = Δx/ur of the pitch-point contact) of "
@@ -683,7 +683,7 @@ def engagement_fine(
     body = "\n".join(
         [
             "## The polished engagement on the issue's grid, Krylov directions "
-            "(`--engagement-fine`, issue 4)",
+            "(`--engagement-fine`)",
             "",
             f"Machine: {machine()}. One engagement along the path of contact (as "
             "`mixed_engagement`), polished surfaces filtered at λs = 2.5 µm (a full film), 700 N m, "
@@ -767,7 +767,7 @@ def _held_row(n, k, thermal, label, polished=False, **model_options):
 def _write_held(rows, k):
     body = "\n".join(
         [
-            "## The deterministic passage a step on finer grids (`--held-steps`, issue 4)",
+            "## The deterministic passage a step on finer grids (`--held-steps`)",
             "",
             f"Machine: {machine()}. The pitch-point contact held (700 N m, SRR 0.3, 3500 rpm), "
             f"ground (polished rows: Rq 0.05 µm, filtered at λs = 2.5 µm), the default "

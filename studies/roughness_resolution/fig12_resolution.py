@@ -1,5 +1,5 @@
 """The contact of Fig. 12 and R10 on finer grids: which grid and which profile give a film that
-no longer moves (issues 4 and 6).
+no longer moves.
 
 R10 (REFERENCE §7): at roll angle 17° and speed E, ground surfaces give asperity pressures above
 3 GPa, polished ones a full film with p well below 2 GPa. The figures solve that contact with the
@@ -93,8 +93,7 @@ def main(argv=None):
     ]
     body = "\n".join(
         [
-            "## The contact of Fig. 12 and R10 on finer grids (`fig12_resolution.py`, "
-            "issues 4 and 6)",
+            "## The contact of Fig. 12 and R10 on finer grids (`fig12_resolution.py`)",
             "",
             f"Machine: {machine()}. The loaded contact nearest 17° (gear 1 roll angle "
             f"{roll:.2f}°) of the calibrated pair's quasi-static mesh cycle at {args.rpm:.0f} rpm, "

@@ -1,4 +1,4 @@
-"""Does the deterministic film converge as the grid refines? The roughness decides (issue 4).
+"""Does the deterministic film converge as the grid refines? The roughness decides.
 
 The synthetic ground profile (exponential autocorrelation, Rq 0.40 µm, ℓ 20 µm) has no finest
 scale: its spectrum falls as 1/f², so a finer EHL grid samples steeper asperities (rms slope ∝
@@ -154,7 +154,7 @@ def main(argv=None):
     body = "\n".join(
         [
             "## Roughness resolution: the deterministic film on finer grids "
-            "(`roughness_resolution.py`, issue 4)",
+            "(`roughness_resolution.py`)",
             "",
             f"Machine: {machine()}. Pitch-point contact, {args.rpm:.0f} rpm, 700 N m, SRR 0.3, "
             "ground (Rq 0.40 µm per surface, ℓ 20 µm, seed 0; polished rows: Rq 0.05 µm), "

@@ -1,4 +1,4 @@
-"""Sensitivity of the paper-fidelity loss to the fluid shear law (REFERENCE §4, issue 6).
+"""Sensitivity of the paper-fidelity loss to the fluid shear law (REFERENCE §4).
 
 The paper's η* = η/cosh(τm/τ0) keeps the fluid shear stress below τ0; the exact Eyring law
 τ = τ0 asinh(η us/(τ0 h)) does not. REFERENCE §4 asks for both and the sensitivity. This runs the

@@ -1,4 +1,4 @@
-"""The transient passage's time step and time scheme against a rough film's friction (issue 4).
+"""The transient passage's time step and time scheme against a rough film's friction.
 
 A deterministic rough film's roughness moves through the contact with the surfaces; with the time
 step tied to the grid (Δt = Δx/ur, EHL_NOTES) the shortest roughness wavelength the grid resolves
@@ -159,7 +159,7 @@ def main(argv=None):
     ]
     body = "\n".join(
         [
-            "## A rough film's friction against the time step (`time_steps.py`, issue 4)",
+            "## A rough film's friction against the time step (`time_steps.py`)",
             "",
             f"Machine: {machine()}. The pitch-point contact held (700 N m, SRR 0.3, 3500 rpm), "
             "iso-thermal. Polished: the surfaces filtered at λs = 2.5 µm (a full film), "
