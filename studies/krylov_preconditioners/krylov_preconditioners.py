@@ -168,8 +168,7 @@ def main(argv=None):
     )
     body = "\n".join(
         [
-            "## Preconditioners of the Krylov Newton directions "
-            "(`krylov_preconditioners.py`)",
+            "## Preconditioners of the Krylov Newton directions (`krylov_preconditioners.py`)",
             "",
             f"Machine: {machine()}. GMRES vectors (SciPy, restart 200) to ‖J d + F‖ ≤ {RTOL:g} ‖F‖ "
             "for the first Newton system of a transient step from the previous step's solution "
