@@ -64,7 +64,7 @@ def _ehl_rows():
     import jax.numpy as jnp
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-    from ehl_cases import gear_contact
+    from helpers import gear_contact
 
     def timed(fn, *args):
         t0 = time.perf_counter()

@@ -28,7 +28,7 @@ import equinox as eqx  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from ehl_cases import dimensionless, gear_contact  # noqa: E402
+from helpers import dimensionless, gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 

@@ -33,7 +33,7 @@ jax.config.update("jax_enable_x64", True)
 sys.path.insert(0, "tests")
 import numpy as np
 import jaxgear as jg
-from ehl_cases import gear_contact
+from helpers import gear_contact
 
 LUB = jg.presets.mil_l_23699()
 out = {"time": {}, "contacts": []}

@@ -4,7 +4,7 @@ import argparse
 import json
 
 import pytest
-from ehl_cases import gear_contact
+from helpers import gear_contact
 
 from jaxgear.cli.commands import ehl as ehl_command
 

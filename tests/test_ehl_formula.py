@@ -9,7 +9,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import E_REDUCED, FACE_WIDTH, gear_contact
+from helpers import E_REDUCED, FACE_WIDTH, gear_contact
 
 import jaxgear as jg
 from jaxgear.lubrication.ehl_formula import ehl_formula_contact

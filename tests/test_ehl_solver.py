@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import dimensionless, gear_contact, moes_contact, pan_hamrock
+from helpers import dimensionless, gear_contact, moes_contact, pan_hamrock
 
 import jaxgear as jg
 

@@ -4,7 +4,7 @@ rolling-power identity. Heavy grids are ``slow``; each slow test has a cheap def
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact, moes_central, moes_contact, pan_hamrock
+from helpers import gear_contact, moes_central, moes_contact, pan_hamrock
 
 import jaxgear as jg
 

@@ -3,7 +3,7 @@ reach the statistical mixed-EHL rung from ``Fidelity`` and the ``[fidelity]`` TO
 the Greenwood-Tripp model says (their sensitivity on the mesh loss:
 ``benchmarks/friction_sensitivity.py``).
 
-Contacts are the paper's pitch-point contact from ``ehl_cases``; roughness the synthetic ground
+Contacts are the paper's pitch-point contact from ``helpers``; roughness the synthetic ground
 (Rq 0.40 µm per surface) and polished (0.05 µm) presets (REFERENCE §6). Every EHLModel is a new
 compilation (~25 s of CPU each), so the default run compiles one; the monotone sweep is ``slow``.
 """
@@ -15,7 +15,7 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact, greenwood_tripp_pressure
+from helpers import gear_contact, greenwood_tripp_pressure
 
 import jaxgear as jg
 from jaxgear.cli.config import fidelity_from_config, sweep_from_config

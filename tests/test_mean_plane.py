@@ -10,7 +10,7 @@ closed forms, and the statistical film at both of its limits.
 - The implicit derivatives with respect to the roughness scale, nβσ and the load against central
   differences across the transition.
 
-Contacts of REFERENCE §2-§3 (``ehl_cases.gear_contact``), Mil-L-23699 at 90 °C.
+Contacts of REFERENCE §2-§3 (``helpers.gear_contact``), Mil-L-23699 at 90 °C.
 """
 
 import math
@@ -20,7 +20,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact, greenwood_tripp_constant
+from helpers import gear_contact, greenwood_tripp_constant
 from scipy import integrate, interpolate, optimize
 
 import jaxgear as jg

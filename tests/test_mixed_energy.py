@@ -14,7 +14,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact, greenwood_tripp_pressure
+from helpers import gear_contact, greenwood_tripp_pressure
 from scipy import integrate
 
 import jaxgear as jg

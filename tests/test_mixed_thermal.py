@@ -1,6 +1,6 @@
 """Thermal mixed EHL (issue 4): asperity contact, roughness, temperatures, transient passage.
 
-Contacts are the paper's pitch-point contact (REFERENCE §2-§3) from ``ehl_cases``; roughness the
+Contacts are the paper's pitch-point contact (REFERENCE §2-§3) from ``helpers``; roughness the
 synthetic ground (Rq 0.40 µm per surface) and polished (0.05 µm) presets (REFERENCE §6).
 """
 
@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import bump_surfaces, gear_contact, greenwood_tripp_constant, held_passage
+from helpers import bump_surfaces, gear_contact, greenwood_tripp_constant, held_passage
 
 import jaxgear as jg
 from jaxgear.lubrication import asperity

@@ -6,7 +6,7 @@ solve converges, inside the compiled solve."""
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact
+from helpers import gear_contact
 
 import jaxgear as jg
 from jaxgear.lubrication.ehl import discretisation

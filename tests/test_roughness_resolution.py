@@ -7,7 +7,7 @@ wavelength, the film closes spuriously over 27 and 15 % of the load)."""
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact
+from helpers import gear_contact
 
 import jaxgear as jg
 from jaxgear.lubrication import roughness as rough

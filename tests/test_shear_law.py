@@ -63,7 +63,7 @@ def test_split_law_damping_is_the_tangent_of_its_traction():
     must equal the exact law's and the damping the paper law's (the same closed forms)."""
     import jax
     import jax.numpy as jnp
-    from ehl_cases import gear_contact
+    from helpers import gear_contact
 
     c = gear_contact(700.0, 2000.0, 0.3)
     um, us0 = 0.5 * (float(c.u1) + float(c.u2)), float(c.u1) - float(c.u2)
@@ -95,7 +95,7 @@ def test_split_law_in_the_ehl_solver():
     film by ``eyring_shear_stress``; the traction lies between the paper law's and the exact law's
     on their own films (η* ≤ τm h/us, and the exact law's thicker-flow film differs by a few %)."""
     import numpy as np
-    from ehl_cases import gear_contact
+    from helpers import gear_contact
 
     from jaxgear.lubrication.rheology import eyring_shear_stress
 
@@ -132,7 +132,7 @@ def test_limiting_shear_stress_closed_forms():
     load), its damping untouched."""
     import jax
     import jax.numpy as jnp
-    from ehl_cases import gear_contact
+    from helpers import gear_contact
 
     from jaxgear.lubrication.ehl_formula import ehl_formula_contact
     from jaxgear.lubrication.rheology import log_limited_stress
@@ -175,7 +175,7 @@ def test_limiting_shear_stress_in_the_ehl_solver():
     """The EHL solver's traction under a binding cap (Λ = 0.005, smooth surfaces) is Λ times the
     load to within the contact edges' share, and the film is untouched (the cap acts on the
     friction and sliding heat only)."""
-    from ehl_cases import gear_contact
+    from helpers import gear_contact
 
     c = gear_contact(700.0, 2000.0, 0.3)
     free = jg.solve_ehl(c, LUB, jg.EHLModel(n_nodes=129, shear="eyring_split"))
@@ -207,7 +207,7 @@ def test_eyring_stress_traction_is_convex_in_load_and_follows_the_viscosity():
     with ln η, which is ≈ α p, so its traction grows faster than the load and rises with the inlet
     viscosity (60 °C against 90 °C). Closed-form contact, smooth, pitch, 2000 rpm, slide-to-roll 0.3;
     measured: exponents 0.60 and 1.26, 60 °C ratios 1.06 and 1.49; the bounds sit halfway."""
-    from ehl_cases import gear_contact
+    from helpers import gear_contact
 
     from jaxgear.lubrication.ehl_formula import ehl_formula_contact
 

@@ -8,7 +8,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import gear_contact
+from helpers import gear_contact
 
 import jaxgear as jg
 from jaxgear.lubrication import passage as passage_mod

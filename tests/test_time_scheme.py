@@ -7,7 +7,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from ehl_cases import bump_surfaces, gear_contact, held_passage
+from helpers import bump_surfaces, gear_contact, held_passage
 
 import jaxgear as jg
 from jaxgear.lubrication.passage import (

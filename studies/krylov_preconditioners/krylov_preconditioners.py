@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
 from _report import ROWS_HELP, RowCache, machine, write_section  # noqa: E402
-from ehl_cases import gear_contact  # noqa: E402
+from helpers import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 from jaxgear.lubrication.ehl.discretisation import _fine_level, _grid_positions  # noqa: E402

@@ -56,7 +56,7 @@ from _report import (  # noqa: E402
     machine,
     write_section,
 )
-from ehl_cases import gear_contact  # noqa: E402
+from helpers import gear_contact  # noqa: E402
 from mixed_thermal import _path_contacts  # noqa: E402
 
 import jaxgear as jg  # noqa: E402

@@ -254,7 +254,7 @@ def limiting():
     (``shear="eyring_split"``): the closed-form contact's fluid traction with the cap over without
     it at the pitch contact, and the coupled quasi-static paper fidelity's R5-R7 ratios with and
     without a binding cap. Section ``shear_limiting``."""
-    from ehl_cases import gear_contact  # tests/ehl_cases.py: the paper's pitch contact
+    from helpers import gear_contact  # tests/helpers.py: the paper's pitch contact
 
     from jaxgear.lubrication.ehl_formula import ehl_formula_contact
 

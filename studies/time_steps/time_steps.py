@@ -42,7 +42,7 @@ from _report import (  # noqa: E402
     row_cache_from_command_line,
     write_section,
 )
-from ehl_cases import gear_contact  # noqa: E402
+from helpers import gear_contact  # noqa: E402
 
 import jaxgear as jg  # noqa: E402
 from jaxgear.lubrication.passage import grid_time_step, solve_ehl_passage  # noqa: E402
