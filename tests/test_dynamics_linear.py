@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 import scipy.linalg
-from _dynamics_cases import numpy_matrices, synthetic_mesh, unequal_pair
+from helpers import numpy_matrices, synthetic_mesh, unequal_pair
 
 import jaxgear as jg
 

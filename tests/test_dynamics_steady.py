@@ -10,7 +10,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from _dynamics_cases import synthetic_mesh
+from helpers import synthetic_mesh
 
 import jaxgear as jg
 from jaxgear.gear.pair import Bearings

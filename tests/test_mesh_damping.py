@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from _dynamics_cases import synthetic_mesh, unequal_pair
+from helpers import synthetic_mesh, unequal_pair
 
 import jaxgear as jg
 from jaxgear.dynamics.model import DynamicsOptions, MeshInterface, build_dynamics
