@@ -1,16 +1,15 @@
 """The research notebooks run top to bottom on the public API (nbclient, python3 kernel)."""
 
 import os
-from pathlib import Path
 
 import nbformat
 import pytest
+from helpers import ROOT
 from nbclient import NotebookClient
 
-ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
 DEFAULT = ("quickstart.ipynb",)
-# run below at reduced resolution (their cheap siblings: tests/test_design_optimise.py)
+# run below at reduced resolution (their cheap siblings: tests/optimise/test_design_optimise.py)
 OWN_TEST = (
     "paper_reproduction.ipynb",
     "tip_relief_optimisation.ipynb",

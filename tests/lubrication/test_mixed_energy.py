@@ -7,7 +7,7 @@ statistical asperity pressure) and the contact's surface velocities, by quadratu
 written here: Couette work |us| ∫ τ dx with τ = η_s |us|/h, the rolling friction's work
 Fr (u1 + u2) = ur ∫ h dp (the continuum identity of the Poiseuille heat, derived in
 ``_rolling_work``), the boundary friction μb ∫ p dx over the contact. Contacts and roughness as in
-tests/test_mixed_thermal.py (REFERENCE §2-§3, §6).
+tests/lubrication/test_mixed_thermal.py (REFERENCE §2-§3, §6).
 """
 
 import jax

@@ -9,6 +9,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from helpers import ROOT
 
 import jaxgear as jg
 from jaxgear.fidelity import Fidelity
@@ -140,7 +141,7 @@ def test_sharded_sweep_equals_single_device(tmp_path):
         capture_output=True,
         text=True,
         timeout=600,
-        cwd=os.path.dirname(os.path.dirname(__file__)),
+        cwd=ROOT,
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
     two, one = np.load(tmp_path / "out.npy")

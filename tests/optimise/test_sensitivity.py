@@ -302,8 +302,8 @@ def test_cli_rejects_bad_input_with_exit_code_2(tmp_path, capsys, argv, words):
     assert words in err and "Traceback" not in err and err.count("\n") == 1, err
 
 
-# the fixed point converged far below its default 1e-4 (as tests/test_differentiable.py), so that
-# central differences are not noise
+# the fixed point converged far below its default 1e-4 (as
+# tests/tribodynamics/test_differentiable.py), so that central differences are not noise
 TRIBO = jg.Fidelity.fast(fixed_point_tolerance=1e-10)
 TRIBO_OUTPUTS = ("efficiency", "power_loss", "dte_rms")
 
@@ -377,10 +377,10 @@ def test_tribo_dynamic_dte_derivative_matches_central_differences(tribo_report, 
 
 @pytest.mark.slow
 def test_a_periodic_orbit_striking_the_back_flanks_has_derivatives(uncounted):
-    # tests/test_back_flanks.py's striking orbit (backlash 5 µm, 1500 N m, 3350 rpm): its second
-    # pass counts the back flanks' loss, and the report's program with both passes differentiates
-    # it; checked on the torque against central differences (steps of 1e-4 relative; the
-    # constant-μ rung and a fixed point to 1e-10: noise ~1e-9 relative in y)
+    # tests/gear/test_back_flanks.py's striking orbit (backlash 5 µm, 1500 N m, 3350 rpm): its
+    # second pass counts the back flanks' loss, and the report's program with both passes
+    # differentiates it; checked on the torque against central differences (steps of 1e-4
+    # relative; the constant-μ rung and a fixed point to 1e-10: noise ~1e-9 relative in y)
     pair = eqx.tree_at(lambda p: p.backlash, PAIR, 5e-6)
     fid = jg.Fidelity(friction="constant", n_positions=32, fixed_point_tolerance=1e-10)
     op = jg.OperatingPoint(torque=1500.0, speed_rpm=3350.0)

@@ -6,7 +6,7 @@ the surface velocities of the dynamic orbit.
 The two sides come from different places: Φ̄ from the shear stress and Poiseuille flow integrated
 over each EHL film (and the asperity shear), the work rate from the tables the fixed point hands to
 the dynamics times the velocities the dynamics computes. On the interface, with the dynamics' sign
-convention (tests/test_dynamics_linear.py: energy balance), the friction dissipates
+convention (tests/dynamics/test_dynamics_linear.py: energy balance), the friction dissipates
 −(F1 u1 − F2 u2) = Fs (u2 − u1) + Fr (u1 + u2): the sliding force's work at the sliding speed and
 the rolling force's at the sum of the surface speeds.
 """

@@ -13,6 +13,7 @@ import sys
 
 import numpy as np
 import pytest
+from helpers import ROOT
 
 import jaxgear as jg
 from jaxgear.cli import main
@@ -578,7 +579,7 @@ def test_cli_in_a_real_process(configs):
         text=True,
         timeout=300,
         env={**os.environ, "JAXGEAR_CACHE_DIR": "off"},
-        cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+        cwd=ROOT,
     )
     assert out.returncode == 2, out.stderr
     assert out.stderr.strip().splitlines() == [

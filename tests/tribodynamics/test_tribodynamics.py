@@ -145,7 +145,7 @@ def test_gradient_tribo_dynamic_wrt_relief_amount_and_start(setup):
     # optimise_tip_relief sets them) through the tribo-dynamic fixed point. ~4 min on 2 cores,
     # nearly all compilation (forward 67 s, jacfwd 163 s with another job on the second core), so
     # slow; the default run differentiates the quasi-static rung (above) and lowers jacfwd through
-    # the tribo-dynamic one (tests/test_attractor.py)
+    # the tribo-dynamic one (tests/dynamics/test_attractor.py)
     pair, lub, surf = setup
     fid = Fidelity(
         friction="regression",

@@ -208,7 +208,7 @@ def test_deterministic_film_at_the_light_load_entry_of_an_engagement_converges()
     # The first contact of a tooth pair's engagement at 3500 rpm (102 N m of the 700 on that pair,
     # the entry's radius and slide-to-roll: M ≈ 4.2, L ≈ 6.6) with the ground roughness in the
     # film. Its smooth start is the light-load, thick-film problem on which both continuations in
-    # the piezo-viscous exponent let the film offset run away (tests/test_ehl_solver.py); a
+    # the piezo-viscous exponent let the film offset run away (test_ehl_solver.py); a
     # deterministic solve used to have only those two cold attempts, so the roughness continuation
     # started from a failed smooth film and the engagement benchmark lost its first step (‖F‖∞ =
     # 0.35 after 1110 Newton iterations, measured). The smooth start now has the attempt without

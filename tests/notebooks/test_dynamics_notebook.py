@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
+from helpers import ROOT
 
-NOTEBOOK = Path(__file__).resolve().parents[1] / "notebooks" / "calibration.ipynb"
+NOTEBOOK = ROOT / "notebooks" / "calibration.ipynb"
 
 
 @pytest.mark.slow  # ~2 min on the shared 2-core CPU (three compiled sweeps)
@@ -20,7 +19,7 @@ def test_calibration_notebook_executes():
         nb,
         timeout=900,
         kernel_name="python3",
-        resources={"metadata": {"path": str(NOTEBOOK.parents[1])}},
+        resources={"metadata": {"path": str(ROOT)}},
     )
     client.execute()
     text = "".join(

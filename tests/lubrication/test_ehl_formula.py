@@ -201,7 +201,7 @@ def test_coupled_rung_consistency_and_fast_preset():
 # contacts at the static loads and kinematic velocities. Measured (2026-11-25, again 2026-12-01):
 # A −3.30 %, B +3.96 %, D −12.24 % (the paper fidelity −4.1, +3.4, −12.1 %, docs/figures/paper).
 # Point E (the paper +78 %) is not reproduced at this preset (README); it is tested at the
-# calibrated one (tests/test_paper_calibrated.py, slow). Same inputs as the test above, so the
+# calibrated one (tests/paper/test_paper_calibrated.py, slow). Same inputs as the test above, so the
 # compiled simulate is reused when both run in one process.
 R3_POINTS = {"A": 1700.0, "B": 1800.0, "D": 3325.0}
 

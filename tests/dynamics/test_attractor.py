@@ -326,7 +326,7 @@ def test_forward_mode_through_the_attractor_branch_lowers():
 def test_forward_mode_gradient_with_the_attractor_branch_matches_central_differences():
     # the implicit derivative of the fixed point (solved by _krylov.EarlyExitGMRES) through the
     # attractor branch against central differences (measured 2026-11-28: 1e-9 and 5e-7 apart);
-    # the slow tests of tests/test_tribodynamics.py do so at the EHL rungs
+    # the slow tests of tests/tribodynamics/test_tribodynamics.py do so at the EHL rungs
     eff, x0 = _attractor_efficiency()
     g = jax.jit(jax.jacfwd(eff))(x0)
     steps = (1e-8, 0.5)  # 1e-3 and 7e-4 of the values

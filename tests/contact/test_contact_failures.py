@@ -75,8 +75,8 @@ def test_coarse_transient_at_1500_nm_is_flagged_and_stays_physical():
     # 65 nodes are too coarse for 1.4 GPa: some contacts fail in both; they are flagged and counted.
     assert int(marched.status) == 3 and int(marched.failed_contacts) >= 1
     # Measured 200.7 W marched against 203.0 W quasi-steady (before the fix: 1.5e18 W). The squeeze
-    # term moves the cycle mean by ~1 % at this speed (tests/test_transient_coupling.py); 5 % allows
-    # for the carried-over contacts.
+    # term moves the cycle mean by ~1 % at this speed (tests/contact/test_transient_coupling.py);
+    # 5 % allows for the carried-over contacts.
     assert abs(float(marched.power_loss) / float(steady.power_loss) - 1.0) < 0.05
 
 

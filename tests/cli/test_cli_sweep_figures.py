@@ -11,17 +11,16 @@ import re
 import subprocess
 import sys
 import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import ROOT
 
 import jaxgear as jg
 from jaxgear.cli import main
 from jaxgear.cli.config import load_toml, sweep_from_config
 from jaxgear.fidelity import Fidelity
 
-ROOT = Path(__file__).resolve().parents[1]
 TINY = """
 [gear]
 preset = "li2015_calibrated"
