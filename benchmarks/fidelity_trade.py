@@ -675,7 +675,7 @@ def auto_and_reach(table) -> list[str]:
         "",
         "`Fidelity.auto` at 5 % (on Φ̄ and Ψ) for each scenario, from this table. In-sample: the "
         "table was measured on these scenarios, so this checks the bookkeeping, not the "
-        "generalisation (tests/test_fidelity_auto.py checks held-out scenarios).",
+        "generalisation (tests/fidelity/test_fidelity_auto.py checks held-out scenarios).",
         "",
         "| scenario | chosen | predicted Φ̄ err % | measured Φ̄ err % | run s/point | reference s/point | cheaper |",
         "|---|---|---|---|---|---|---|",

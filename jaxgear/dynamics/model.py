@@ -48,7 +48,7 @@ the x equations get +sin 2α_w f_b (gear 1) and −sin 2α_w f_b (gear 2): each 
 V = ½km⟨d⟩² + ½km_b⟨d_b⟩². (With the module's axes: e_y along LOA1 from the driver towards the
 driven gear, e_x against the surfaces' tangential motion at the drive contact, the force on gear 1
 is f_b (−cos 2α_w e_y + sin 2α_w e_x) = f_b e_2, e_2 the unit vector along LOA2 whose force has
-the driving moment; tests/test_back_flanks.py builds both in the plane of the gears.)
+the driving moment; tests/gear/test_back_flanks.py builds both in the plane of the gears.)
 
 The back contacts at phase τ are the drive contacts at phase frac(c − τ)
 (``gear.mesh.back_flank_phase``), so ``back_flank="mirrored"`` (the default) gives the back flanks

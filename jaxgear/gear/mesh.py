@@ -185,7 +185,7 @@ def back_flank_phase(pair: GearPair, tau):
     clearance is left out: the teeth are thinned by the backlash and turn through it before the
     back flanks touch, which moves s′ by at most the clearance 2ℓ along the line (0.14 mm against
     pb = 8.86 mm for the paper's pair). Tested against the tooth thickness of an involute built
-    through both contact points (tests/test_back_flanks.py)."""
+    through both contact points (tests/gear/test_back_flanks.py)."""
     geo = gear_geometry(pair)
     alpha, alpha_w = pair.pressure_angle, geo.operating_pressure_angle
     rb1, r_ref1 = geo.base_radius[0], geo.reference_pitch_radius[0]

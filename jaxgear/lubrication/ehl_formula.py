@@ -2,7 +2,7 @@
 
 A line contact of the statistical mixed EHL rung (``EHLModel(mixed="statistical")``) without the
 Reynolds solve. Each piece is a published closed form, evaluated with the same lubricant, roughness and
-shear law as the EHL rungs, and checked against the EHL solver in ``tests/test_ehl_formula.py``:
+shear law as the EHL rungs, and checked against the EHL solver in ``tests/lubrication/test_ehl_formula.py``:
 
 - **Film**: Pan & Hamrock's (1989) central film h_c (REFERENCE §8) of smooth surfaces, and the
   average gap that carries the flow on rough ones, h_T,c = h_c + σ g(h_c/σ). The thickening

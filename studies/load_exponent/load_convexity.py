@@ -106,7 +106,7 @@ def load_exponents():
 def _attractor_cycles(op, mesh, warm):
     """Tooth forces and velocities [K, M, 2(, 2)] of the K cycles whose contacts make the means of a
     status-6 point: the record ``simulate`` took (rebuilt from its WarmStart, as in
-    tests/test_attractor.py: a cold single point starts from the unstable orbit with the kick)."""
+    tests/dynamics/test_attractor.py: a cold single point starts from the unstable orbit with the kick)."""
     options = dynamics_options(FID)
     dyn = build_dynamics(PAIR, op, mesh, warm.interface, options)
     rec = record_attractor(

@@ -47,7 +47,7 @@ ROOT = Path(__file__).resolve().parents[2]
 README = Path(__file__).with_name("README.md")  # this study's sections
 sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
 sys.path.insert(0, str(ROOT / "studies" / "mixed_thermal"))  # _path_contacts
-sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).parents[2] / "tests"))
 
 from _report import (  # noqa: E402
     ROWS_HELP,

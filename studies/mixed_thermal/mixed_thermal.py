@@ -68,7 +68,7 @@ import jax.numpy as jnp  # noqa: E402
 ROOT = Path(__file__).resolve().parents[2]
 README = Path(__file__).with_name("README.md")  # this study's sections
 sys.path.insert(0, str(ROOT / "benchmarks"))  # _report
-sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).parents[2] / "tests"))
 
 from _report import (  # noqa: E402
     RESULTS,

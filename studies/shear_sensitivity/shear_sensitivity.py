@@ -335,7 +335,7 @@ def limiting():
 
 if __name__ == "__main__":
     if "--limiting" in sys.argv:
-        sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+        sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
         limiting()
     elif "--trends" in sys.argv:
         dp = None
