@@ -15,7 +15,6 @@ the tooth forces themselves, and the smooth-EHL rung at the extremes.
 import functools
 import itertools
 
-import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -241,21 +240,26 @@ def test_tribo_dynamic_constant_rung_extremes_slow():
 
 
 @pytest.mark.slow
-def test_light_load_at_resonance_loses_contact_and_hits_back_flanks_slow():
-    """The light-load points of the default test really do what they are there for: at 10 N m and
-    3500 rpm the tooth force drops to zero over part of the cycle (contact loss), and with no
-    backlash it turns negative (back-side contact); every result finite or flagged."""
+def test_light_load_at_resonance_loses_contact_slow():
+    """The light-load points of the default test really do what they are there for. At 10 N m the
+    teeth separate: at 4000 rpm the periodic orbit's tooth force drops to zero over part of the
+    cycle (contact loss) without reaching the back flanks (0.14 mm backlash: back_contact_share
+    0); at 3500 rpm, on the resonance, the rattle has no stable periodic orbit at all (status 6,
+    means over the attractor; at this load 3000-3700 rpm). Every result finite or flagged.
+    Back-flank strikes themselves are checked in tests/gear/test_back_flanks.py. (Zero backlash
+    does not force them here: the separation comes from the tip relief, which the back flanks
+    carry too.)"""
     fid = jg.Fidelity(friction="regression")
-    op = jg.OperatingPoint(torque=10.0, speed_rpm=3500.0)
-    lost = jg.simulate(PAIR, LUB, SURF, op, fid)
-    tight = eqx.tree_at(lambda p: p.backlash, PAIR, jnp.asarray(0.0))
-    back = jg.simulate(tight, LUB, SURF, op, fid)
-    for res in (lost, back):
+    lost = jg.simulate(PAIR, LUB, SURF, jg.OperatingPoint(torque=10.0, speed_rpm=4000.0), fid)
+    rattle = jg.simulate(PAIR, LUB, SURF, jg.OperatingPoint(torque=10.0, speed_rpm=3500.0), fid)
+    for res in (lost, rattle):
         values = [res.power_loss, res.dte_rms, res.tooth_force, res.power_loss_position]
         assert all(bool(jnp.all(jnp.isfinite(v))) for v in values) or int(res.status) != 0
+    assert int(lost.status) == 0
     force = np.asarray(lost.tooth_force).sum(axis=1)
     assert force.min() == 0.0 and force.max() > 0.0
-    assert np.asarray(back.tooth_force).sum(axis=1).min() < 0.0
+    assert float(lost.back_contact_share) == 0.0
+    assert int(rattle.status) == int(jg.Status.ATTRACTOR)
 
 
 @pytest.mark.slow
