@@ -75,7 +75,8 @@ def main():
     lines += [
         "",
         "Paper (REFERENCE §7): 532 W quasi-static, 948 W tribo-dynamic at point E. Status: 0 ok, "
-        "1 fixed point, 2 dynamics, 3 a contact solve, 4 non-finite (tribodynamics.STATUS_*).",
+        "2 dynamics not converged, 3 a contact solve, 6 no stable periodic orbit (means over the "
+        "attractor) (`jaxgear.results.Status`).",
     ]
     write_section("paper_point", "\n".join(lines))
 
