@@ -2,7 +2,7 @@
 in the film.
 
 The coupled model's R3 at point E and R7's efficiency (REFERENCE §7) turn on the load exponent
-k = d ln Φ/d ln W of a contact's loss (docs/open_points.md: with the statistical
+k = d ln Φ/d ln W of a contact's loss (docs/limitations.md: with the statistical
 Greenwood-Tripp contact k ≈ 0.6, concave, and a dynamic load swing lowers the cycle's mean loss;
 ``load_convexity.py`` beside this script). Greenwood-Tripp's asperity pressure is a function of the film
 h/σ alone, and the film hardly depends on the load, so the asperity load grows with the Hertz

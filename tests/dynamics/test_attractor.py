@@ -398,7 +398,7 @@ def test_back_flank_strikes_are_counted_from_the_record_not_the_mean_loads(at_34
     share of the cycle they take (``back_contact_share``) and their loss (``power_loss_back``,
     part of Φ̄) come from the attractor's recorded cycles. At 3850 rpm (default fidelity) the
     attractor strikes back (the frictionless dynamics alone: 0.32 of the record at 3900 rpm,
-    benchmarks/attractor.py; docs/open_points.md, back-flank contact), while the mean tooth
+    benchmarks/attractor.py; docs/limitations.md, back-flank contact), while the mean tooth
     forces the result reports are positive at every position (the strikes average out), so a
     share or a loss from them would read 0. At 3450 rpm the teeth separate but do not strike
     back, and a stable orbit (2500 rpm) and the quasi-static cycle carry none."""
