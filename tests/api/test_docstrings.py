@@ -12,6 +12,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import pytest
+
 import jaxgear
 
 ROOT = Path(jaxgear.__file__).resolve().parent
@@ -79,8 +81,6 @@ def test_readme_is_a_users_page():
     "measured on" note, and its test command is the one CI runs (``.ci/run``)."""
     readme = REPO / "README.md"
     if not readme.exists():  # an installed package without its repository
-        import pytest
-
         pytest.skip("README.md is not beside the package")
     lines = readme.read_text(encoding="utf-8").splitlines()
     assert len(lines) <= MAX_README_LINES, f"README.md has {len(lines)} lines"
