@@ -274,7 +274,9 @@ def _warm_args(sol: EHLSolution, window: bool = False, moved: bool = False, plas
         hc = jnp.sum(w * sol.h) / jnp.sum(w)
     ratio = hc / jnp.where(sol.moes_film > 0.0, sol.moes_film, jnp.inf)
     ratio = jnp.where(jnp.isfinite(ratio) & (ratio > 0.0), jnp.clip(ratio, 0.05, 20.0), 1.0)
-    p = jnp.where(jnp.isfinite(sol.fluid_pressure), sol.fluid_pressure, 0.0) / ph
+    # the total pressure: the pressure unknown of every film (a statistical film's fluid and
+    # asperity pressures together; the others carry no asperity pressure)
+    p = jnp.where(jnp.isfinite(sol.p), sol.p, 0.0) / ph
     # a yielded film (``EHLModel.hardness``): the unknowns v = P + δ/(c H_ref) above the limit, so
     # that the start keeps its plastic gap (zero for elastic films)
     film_scale = _PLASTIC_GAP_SCALE * jnp.where(sol.moes_film > 0.0, sol.moes_film, jnp.inf)
