@@ -25,6 +25,7 @@ where the average gap has closed anyway.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import jax
@@ -41,19 +42,50 @@ _FAR = 12.0  # λ above which F_n is taken as 0 (F_{5/2}(12) ≈ 1e-36)
 def gt_integral(order: float, lam, points: int = 160):
     """F_n(λ) = (2π)^(−½) ∫_λ^∞ (s − λ)^n exp(−s²/2) ds, any λ (array), n > −1, by
     Gauss-Legendre quadrature of ``points`` (160: to ~1e-11 relative for n = 5/2 on
-    λ ∈ [−6, 6]; 48: to ~1e-7, what the EHL solver's residual uses)."""
-    lam = jnp.asarray(lam)
+    λ ∈ [−6, 6]; 48: to ~1e-7, what the EHL solver's residual uses).
+
+    Its derivative is the closed form dF_n/dλ = −n F_{n−1} (n ≥ 1), by the same quadrature: one
+    pass of exponentials gives a value and its slope, so a Jacobian's directional derivatives cost
+    a product each instead of a differentiated quadrature."""
+    if order >= 1.0:
+        return _gt_smooth(float(order), points, jnp.asarray(lam))
+    return _gt_quadrature((order,), points, jnp.asarray(lam))[0]
+
+
+def _gt_quadrature(orders, points, lam):
+    """(F_n(λ) for n in ``orders``), from one evaluation of the integrand's exponential.
+
+    On [0, span] the quadrature points are t = u·span (u the rule's points mapped to [0, 1]), so
+    tⁿ = uⁿ spanⁿ: the powers are constants times one power of the span, not a power per point."""
     nodes, weights = _RULES[points]
+    u = 0.5 * (nodes + 1.0)
     # beyond λ = 12, F_n < 1e-33: zero. Why cut: the integrand's exp(−(λ + t)²/2) would pass
     # through the subnormal range (λ + t ≈ 38) at the thick inlet films of an EHL grid, and
     # arithmetic on subnormals is ~100 × slower on x86 (it slowed a 257-node solve 20×)
     far = lam > _FAR
     lam = jnp.where(far, _FAR, lam)
     span = 9.0 + jnp.maximum(-lam, 0.0)  # the Gaussian tail beyond λ + span is < 1e-18
-    t = 0.5 * (nodes + 1.0) * span[..., None]  # (…, q) quadrature points on [0, span]
-    w = 0.5 * weights * span[..., None]
-    f = t**order * jnp.exp(-0.5 * (lam[..., None] + t) ** 2)
-    return jnp.where(far, 0.0, jnp.sum(w * f, axis=-1) / math.sqrt(2.0 * math.pi))
+    g = jnp.exp(-0.5 * (lam[..., None] + u * span[..., None]) ** 2)
+    out = []
+    for n in orders:
+        w = jnp.asarray(0.5 * weights * u**n / math.sqrt(2.0 * math.pi))
+        out.append(jnp.where(far, 0.0, span ** (n + 1.0) * jnp.sum(w * g, axis=-1)))
+    return out
+
+
+@functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1))
+def _gt_smooth(order, points, lam):
+    return _gt_quadrature((order,), points, lam)[0]
+
+
+@_gt_smooth.defjvp
+def _gt_smooth_jvp(order, points, primals, tangents):
+    (lam,), (dlam,) = primals, tangents
+    if order >= 2.0:  # F_{n−1} has its own closed-form derivative (second derivatives)
+        value, lower = _gt_quadrature((order,), points, lam)[0], _gt_smooth(order - 1.0, points, lam)
+    else:
+        value, lower = _gt_quadrature((order, order - 1.0), points, lam)
+    return value, -order * lower * dlam
 
 
 def asperity_constant(density_product, slope_ratio):
