@@ -96,6 +96,10 @@ def test_deterministic_full_ground_at_speed_e_converges_with_asperity_pressures_
     assert np.all(np.isfinite(np.asarray(sol.p)))
 
 
+# slow (~90 s, most of it compiling two deterministic transient programs): the relaxed warm start
+# is the default path of every deterministic transient step, which the default set runs in
+# test_thermal_passage.py (the 129-node thermal passage) and test_plasticity.py (the run-in passage)
+@pytest.mark.slow
 def test_deterministic_transient_step_is_reached_from_the_previous_step_by_relaxation():
     # One transient step of the full ground roughness at speed E (257 nodes, Δt = Δx/ur: each
     # surface moves about one cell, which changes its height by ~0.4 µm rms, more than the
@@ -301,6 +305,11 @@ def test_temperature_rise_grows_with_speed_and_heat_is_conserved():
     assert rises[1] > rises[0] > 0.0
 
 
+# slow (~100 s): the relaxed, step-limited temperature update it checks at full roughness is
+# checked by default on its own (the two Aitken tests below) and, in a thermal deterministic solve,
+# by test_a_failed_thermal_deterministic_re_solve_ends_the_temperature_iteration and the 129-node
+# thermal passage of test_thermal_passage.py
+@pytest.mark.slow
 def test_thermal_deterministic_full_ground_settles_by_relaxed_temperature_updates():
     # The paper's ground surfaces at full roughness in the film, speed E, 257 nodes, thermal. With
     # the unrelaxed update the temperatures swung between films ~150 and ~740 K hot (the
