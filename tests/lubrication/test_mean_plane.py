@@ -251,6 +251,20 @@ def test_rolling_speed_to_zero_tends_to_the_dry_rough_contact():
     assert float(np.max(dry)) < 0.9 * ph
 
 
+def test_transient_engagement_in_deep_contact_converges_at_every_step():
+    # 3 × ground at 300 rpm: the mean planes overlap (d < 0) over the whole engagement. Each time
+    # step starts from the last; its central film must be carried as the average gap (positive
+    # however deep the contact), not as the mean-plane separation, which a ratio of film
+    # estimates cannot move to the next contact. Carried as the separation, every step's start
+    # was wrong and the engagement ended with status 3 (a contact not converged) at 300 and
+    # 600 rpm, on 65 and 129 nodes; carried as the gap, status 0.
+    fid = jg.Fidelity.paper(dynamics="quasi_static", thermal=False, n_positions=24, n_nodes=65)
+    op = jg.OperatingPoint(torque=700.0, speed_rpm=300.0, inlet_temperature=363.15)
+    res = jg.simulate(jg.presets.li2015_pair_calibrated(), LUB, ground(3.0), op, fidelity=fid)
+    assert int(res.status) == 0, res.status
+    assert math.isfinite(float(res.power_loss)) and float(res.power_loss) > 0.0
+
+
 # --------------------------------------------------------------------------------------------------
 # Derivatives across the transition
 # --------------------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .. import asperity as asperity_mod
 from .discretisation import _BAND, _KRYLOV_BLOCK, _PLASTIC_GAP_SCALE, _bands, _fine_level, _Level
 from .model import EHLModel, _Inputs
 from .newton import _newton
@@ -139,6 +140,10 @@ def _warm_start(fine: _Level, init_x, init_p, init_h0, window: bool = False):
     p = p.at[0].set(0.0).at[-1].set(0.0)
     if not window:
         hc = init_h0 * fine.sc.h_ref
+        if fine.inp.mean_plane:
+            # the ratio scales the central average gap (positive however deep the contact); the
+            # film unknown is the mean-plane separation under it
+            hc = asperity_mod.separation_of_gap(hc, fine._roughness())
         return jnp.concatenate([p, _offset_for_central_film(fine, p, hc)[None]])
     # rough film whose roughness moved since (a transient step): the previous pressure averaged
     # over 5 cells, so that its asperity spikes, which stand where the roughness was, are spread
@@ -268,7 +273,10 @@ def _warm_args(sol: EHLSolution, window: bool = False, moved: bool = False, plas
     passage)."""
     b = jnp.where(sol.hertz_half_width > 0.0, sol.hertz_half_width, 1.0)
     ph = jnp.where(sol.hertz_pressure > 0.0, sol.hertz_pressure, 1.0)
-    hc = sol.h_central
+    # the central film that carries the flow: the average gap of a statistical film (its
+    # mean-plane separation, the film unknown, may be near zero or negative in deep contact,
+    # where no ratio of film estimates carries it to a nearby contact); the film of the others
+    hc = jnp.interp(0.0, sol.x, sol.gap)
     if window:
         w = _central_window(sol.x / b)
         hc = jnp.sum(w * sol.h) / jnp.sum(w)
