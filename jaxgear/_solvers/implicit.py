@@ -72,14 +72,19 @@ def _implicit_jvp(primals, tangents):
     nondiff, diff = eqx.partition(inputs, no_tangent, is_leaf=_is_none)
     root, residual = _implicit(fn_primal, fn_rewrite, inputs, tags, linear_solver)
 
-    def rewrite_at(root_, args):
-        return fn_rewrite(root_, residual, args)
+    def rewrite(root_, diff_):
+        return fn_rewrite(root_, residual, eqx.combine(diff_, nondiff))
 
-    def rewrite_of(diff_):
-        return fn_rewrite(root, residual, eqx.combine(diff_, nondiff))
+    # One linearisation at the root gives both the operator ∂F/∂root and the right-hand side
+    # ∂F/∂θ·θ̇: the map F (the fixed point's whole step, with its periodic-orbit solve) is evaluated
+    # once for the derivative, not once per use, and the Krylov products are linear maps of stored
+    # residuals, not new evaluations of F.
+    _, linear = jax.linearize(rewrite, root, diff)
+    zero_root = jtu.tree_map(jnp.zeros_like, root)
+    zero_diff = jtu.tree_map(jnp.zeros_like, diff)
 
     def matvec(v):
-        return jax.jvp(lambda r: rewrite_at(r, inputs), (root,), (v,))[1]
+        return linear(v, zero_diff)
 
     def solve(mv, b, transposed=False):
         # throw=False: a solver that fails says so in its value (EarlyExitGMRES(nan_on_failure=
@@ -94,7 +99,7 @@ def _implicit_jvp(primals, tangents):
     def transpose_solve(mv, b):
         return solve(mv, b, transposed=True)
 
-    _, rhs = jax.jvp(rewrite_of, (diff,), (t_inputs,))
+    rhs = linear(zero_root, t_inputs)
     # Parts of the right-hand side that no input tangent reaches (the state's non-differentiated
     # parts) come out as constant zeros; custom_linear_solve transposes only a right-hand side
     # that is linear throughout, so each leaf gets a zero that is (0 × the sum of the others).
