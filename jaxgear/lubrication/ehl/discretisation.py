@@ -376,26 +376,32 @@ class _Level(eqx.Module):
 
     def bands(self, u, s):
         """The band derivatives of ``local`` at u (``_bands``) with respect to the unknowns v and
-        to the elastic film (the film without the plastic gap), and dP/dv (None without a
-        pressure limit): J = band(dv) + dh D diag(dP/dv)."""
+        to the elastic film (the film without the plastic gap), dP/dv (None without a pressure
+        limit), and ``local`` itself at u: J = band(dv) + dh D diag(dP/dv)."""
         v = u[: self.n]
         if self.model.hardness is None:
-            _, dvs, dhs = _bands(lambda pp, hh: self.local(pp, hh, s), v, self.film(u))
-            return dvs, dhs, None
+            value, dvs, dhs = _bands(lambda pp, hh: self.local(pp, hh, s), v, self.film(u))
+            return dvs, dhs, None, value
         elastic = self.film(u) - self.plastic(v)[1]
 
         def local_v(vv, hh):
             pp, dd = self.plastic(vv)
             return self.local(pp, hh + dd, s)
 
-        _, dvs, dhs = _bands(local_v, v, elastic)
+        value, dvs, dhs = _bands(local_v, v, elastic)
         slope = jax.jvp(lambda vv: self.plastic(vv)[0], (v,), (jnp.ones_like(v),))[1]
-        return dvs, dhs, slope
+        return dvs, dhs, slope, value
 
     def jacobian(self, u, s=1.0):
+        return self.residual_and_jacobian(u, s)[1]
+
+    def residual_and_jacobian(self, u, s=1.0):
+        """(``residual``, its Jacobian) at u, from one linearisation of the residual: Newton's
+        iteration reads the residual at its iterate here instead of evaluating it again."""
         n = self.n
         p = u[:n]
-        dps, dhs, slope = self.bands(u, s)
+        dps, dhs, slope, value = self.bands(u, s)
+        residual = jnp.concatenate([value, self.load_row(self.plastic(p)[0])[None]])
         rows = jnp.arange(n)
         offsets = _BAND
         # J[i, j] = Σ_k dP_k[i] [j = i + k] + Σ_k dH_k[i] D[i + k, j]: the shifted influence rows
@@ -421,7 +427,7 @@ class _Level(eqx.Module):
         if slope is not None:
             load = load * slope
         bottom = jnp.concatenate([load[None, :], jnp.zeros((1, 1))], axis=1)
-        return jnp.concatenate([top, bottom], axis=0)
+        return residual, jnp.concatenate([top, bottom], axis=0)
 
 
 _BAND = (-2, -1, 0, 1)  # node offsets k of the banded dependence of a node's residual on P, H

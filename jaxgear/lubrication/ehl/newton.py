@@ -94,7 +94,7 @@ def _block_preconditioner(level: _Level, u, s):
     truncated deformation derivative loses its diagonal.)"""
     n, size = level.n, _KRYLOV_BLOCK
     count = -(-n // size)
-    dps, dhs, slope = level.bands(u, s)
+    dps, dhs, slope, _ = level.bands(u, s)
 
     def blocked(v, fill=0.0):
         return jnp.concatenate([v, jnp.full((count * size - n,), fill, v.dtype)]).reshape(
@@ -138,8 +138,8 @@ def _bordered_solve(level: _Level, factors, v):
     return jnp.concatenate([y - xi * column_solved, xi[None]])
 
 
-def _krylov_direction(level: _Level, u, s, f):
-    """Newton direction d ≈ −J⁻¹F without forming J: GMRES (right-preconditioned by
+def _krylov_direction(level: _Level, u, s):
+    """(F(u), Newton direction d ≈ −J⁻¹F) without forming J: GMRES (right-preconditioned by
     ``_block_preconditioner``) on J·v = ∂F/∂u·v by forward mode through the residual, whose
     deformation is the DC-FFT product. O(N log N) an iteration instead of the dense LU's O(N³).
     GMRES stops at ‖J d + F‖ ≤ ``_DIRECTION_TOLERANCE``‖F‖ (inexact Newton: each Newton iteration
@@ -151,7 +151,7 @@ def _krylov_direction(level: _Level, u, s, f):
     Newton iterations a step do not depend on the GMRES tolerance between 1e-2 and 1e-5.
     """
     factors = _block_preconditioner(level, u, s)
-    _, jvp = jax.linearize(lambda v: level.residual(v, s), u)
+    f, jvp = jax.linearize(lambda v: level.residual(v, s), u)
 
     def preconditioned(y):
         return jvp(_bordered_solve(level, factors, y))
@@ -164,7 +164,7 @@ def _krylov_direction(level: _Level, u, s, f):
         max_restarts=_KRYLOV_CYCLES,
     )
     y = lx.linear_solve(op, -f, solver, throw=False).value
-    return _bordered_solve(level, factors, y)
+    return f, _bordered_solve(level, factors, y)
 
 
 def _newton(level: _Level, u0, s, max_iter: int, tol=None):
@@ -172,12 +172,14 @@ def _newton(level: _Level, u0, s, max_iter: int, tol=None):
     Returns (u, ‖F‖∞, iterations, converged)."""
     tol = level.model.tolerance if tol is None else tol
 
+    def merit_of(f):
+        m = jnp.sum(f * f)
+        return jnp.where(jnp.isfinite(m), m, jnp.inf)
+
     def merit(u):
         f = level.residual(u, s)
-        m = jnp.sum(f * f)
-        return f, jnp.where(jnp.isfinite(m), m, jnp.inf)
+        return f, merit_of(f)
 
-    f0, m0 = merit(u0)
     # large grids carry the last single-precision LU from one iteration to the next (a chord step
     # when it still gives an accurate direction); the first iteration starts from a zero "LU",
     # whose non-finite direction fails the accuracy test, so it factorises
@@ -191,12 +193,18 @@ def _newton(level: _Level, u0, s, max_iter: int, tol=None):
         return (~stop) & (it < max_iter)
 
     def body(state):
-        u, f, m, it, _, lu = state
+        u, _, _, it, _, lu = state
+        # the residual at u comes with the linearisation the direction needs (no evaluation of its
+        # own: the residual is most of the program, and each call site is compiled anew)
         if krylov:
-            d = _krylov_direction(level, u, s, f)
+            f, d = _krylov_direction(level, u, s)
         else:
-            d, lu = _newton_direction(jac=level.jacobian(u, s), f=f, lu_prev=lu)
-        d = jnp.where(jnp.isfinite(d), d, 0.0)
+            f, jac = level.residual_and_jacobian(u, s)
+            d, lu = _newton_direction(jac=jac, f=f, lu_prev=lu)
+        m = merit_of(f)
+        # a start that meets the tolerance is kept as it is, and takes no iteration
+        converged = _norm_inf(f) < tol
+        d = jnp.where(jnp.isfinite(d) & ~converged, d, 0.0)
         # cap the film-offset change per step: a runaway H0 is the usual way a far start diverges
         cap = 0.5 * jnp.maximum(jnp.abs(u[-1]), 10.0 * level.sc.h_ref)
         d = d * jnp.minimum(1.0, cap / jnp.maximum(jnp.abs(d[-1]), 1e-300))
@@ -204,7 +212,7 @@ def _newton(level: _Level, u0, s, max_iter: int, tol=None):
         # backtracking α = 1, 1/2, … (Armijo on ½‖F‖²); one call site keeps the compiled loop small
         def ls_cond(ls):
             alpha, _, m_new, k = ls
-            return (m_new > (1.0 - 1e-4 * alpha) * m) & (k < 12)
+            return (m_new > (1.0 - 1e-4 * alpha) * m) & (k < 12) & ~converged
 
         def ls_body(ls):
             alpha, _, _, k = ls
@@ -217,15 +225,23 @@ def _newton(level: _Level, u0, s, max_iter: int, tol=None):
             ls_body,
             (jnp.asarray(1.0, dtype=u.dtype), f, jnp.asarray(jnp.inf, dtype=u.dtype), 0),
         )
-        ok = jnp.isfinite(m_new)
+        ok = jnp.isfinite(m_new) & ~converged
         u_new = jnp.where(ok, u + alpha * d, u)
         f_new = jnp.where(ok, f_new, f)
         m_new = jnp.where(ok, m_new, m)
-        done = _norm_inf(f_new) < tol
+        done = converged | (_norm_inf(f_new) < tol)
         stalled = (~ok) | (alpha * _norm_inf(d) < 1e-15)
-        return u_new, f_new, m_new, it + 1, done | stalled, lu
+        return u_new, f_new, m_new, it + jnp.where(converged, 0, 1), done | stalled, lu
 
-    init = (u0, f0, m0, jnp.asarray(0), _norm_inf(f0) < tol, lu0)
+    dtype = u0.dtype
+    init = (
+        u0,
+        jnp.full_like(u0, jnp.inf),
+        jnp.asarray(jnp.inf, dtype),
+        jnp.asarray(0),
+        jnp.asarray(False),
+        lu0,
+    )
     u, f, m, it, _, _ = jax.lax.while_loop(cond, body, init)
     res = _norm_inf(f)
     return u, res, it, res < tol
