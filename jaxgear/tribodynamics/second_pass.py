@@ -34,6 +34,7 @@ ATTRACTOR_CONTACT_CYCLES = 64
 # attractor moves little between neighbouring speeds (checked by the attractor tests).
 ATTRACTOR_WARM_SETTLE = 200
 
+
 def back_flank_power(pair, op, fidelity, mesh, mesh_force, contacts):
     """The back flanks' power loss per position [M] (sliding, rolling), W: the means over the
     cycles of ``mesh_force`` [C, M] (the back flanks' force, ≤ 0) of the back-flank contacts
@@ -124,15 +125,15 @@ def record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st):
     return each
 
 
-def orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
-    """(back_contact_share, (sliding, rolling) back-flank power per position [M]) of the fixed
-    point's periodic orbit ``st``: its back-flank contacts, where the back flanks' force
-    (``DynamicResponse.back_force``) is negative, solved as an attractor's (``record_contacts``,
-    ``back_flank_power``); zeros where it has none (no periodic orbit of the calibrated pair's
-    baseline has any; a light load or a small backlash gives them). A vmap-lazy cond: a sweep
-    none of whose points strikes back skips it (run for every member, it costs a parallel sweep
-    at ``Fidelity.fast()`` ~12 % more)."""
-    force = st["back_force"][None]  # [1, M]
+def back_flanks(pair, lubricant, surfaces, op, fidelity, mesh, st, force):
+    """(sliding, rolling) back-flank power per position [M] of the back flanks' force samples
+    ``force`` [C, M] (``back_flank_power``: means over the C cycles), their contacts solved as an
+    attractor's (``record_contacts``, from the fixed point's state ``st``); zeros where no sample
+    is negative (no periodic orbit of the calibrated pair's baseline strikes the back flanks; a
+    light load or a small backlash makes them). A vmap-lazy cond: a sweep none of whose points
+    strikes back skips it (run for every member, it costs a parallel sweep at
+    ``Fidelity.fast()`` ~12 % more). One call site for the orbit's and the attractor's samples:
+    the back flanks' mesh cycle and contacts are traced once."""
 
     # the fidelity goes in the operand: its constants are arrays of this trace, which a branch
     # must not close over (the lazy cond's JVP rule re-traces its branches)
@@ -147,7 +148,15 @@ def orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
         return zero, zero
 
     operand = (pair, lubricant, surfaces, op, fidelity, mesh, st, force)
-    power = cond_any_member(jnp.any(force < 0.0), strikes, none, operand, all_true_path=False)
+    return cond_any_member(jnp.any(force < 0.0), strikes, none, operand, all_true_path=False)
+
+
+def orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st):
+    """(back_contact_share, (sliding, rolling) back-flank power per position [M]) of the fixed
+    point's periodic orbit ``st``: its back-flank contacts, where the back flanks' force
+    (``DynamicResponse.back_force``) is negative (``back_flanks``)."""
+    force = st["back_force"][None]  # [1, M]
+    power = back_flanks(pair, lubricant, surfaces, op, fidelity, mesh, st, force)
     return jnp.mean((force < 0.0).astype(force.dtype)), power
 
 
@@ -184,6 +193,10 @@ def attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status
     (``cond_any_member(..., mixed="map")``)."""
     keys = ("forces", "load", "velocity", "dte", "damper", "back_force", "interface", "guess")
     st = {k: state[k] for k in keys}
+    # ATTRACTOR_CONTACT_CYCLES cycles spread over the whole record (the window's length, not
+    # the sample count, sets the bias of the mean), one from every block of `stride`
+    stride = max(1, fidelity.attractor_periods // ATTRACTOR_CONTACT_CYCLES)
+    n_samples = fidelity.attractor_periods // stride
     operand = (pair, lubricant, surfaces, op, fidelity, mesh, st, status, warm)
 
     def on_attractor(operand):
@@ -213,12 +226,10 @@ def attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status
 
         each = record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st)
 
-        # ATTRACTOR_CONTACT_CYCLES cycles spread over the whole record (the window's length, not
-        # the sample count, sets the bias of the mean), one from every block of `stride`, at a
-        # position in the block that cycles through 0..stride−1 so that a period-2, -3 or -4
-        # attractor is not sampled at one of its phases only
-        stride = max(1, fidelity.attractor_periods // ATTRACTOR_CONTACT_CYCLES)
-        k = jnp.arange(fidelity.attractor_periods // stride)
+        # the samples (``n_samples``), each at a position in its block that cycles through
+        # 0..stride−1 so that a period-2, -3 or -4 attractor is not sampled at one of its phases
+        # only
+        k = jnp.arange(n_samples)
         pick = k * stride + k % stride
         loads, speeds = rec.tooth_force[pick], rec.surface_velocity[pick]
         per_cycle = jax.vmap(each)(loads, speeds)
@@ -244,27 +255,31 @@ def attractor_means(pair, lubricant, surfaces, op, fidelity, mesh, state, status
         status = jnp.where(ok, STATUS_ATTRACTOR, status).astype(status.dtype)
         orbit_share = jnp.mean((st["back_force"] < 0.0).astype(load.dtype))
         back = jnp.where(ok, jnp.mean((rec.back_force < 0.0).astype(load.dtype)), orbit_share)
-        back_power = back_flank_power(pair, op, fidelity, mesh, rec.back_force[pick], each)
-        back_power = jax.tree_util.tree_map(
-            lambda a: jnp.where(ok & jnp.all(jnp.isfinite(a)), a, 0.0), back_power
-        )
-        return (picked, status, handover, back, back_power)
+        # the back flanks' force at the same cycles, evaluated after the branch (``back_flanks``)
+        samples = jnp.where(ok & jnp.all(jnp.isfinite(rec.back_force)), rec.back_force[pick], 0.0)
+        return (picked, status, handover, back, samples)
 
     def keep(operand):
         pair, lubricant, surfaces, op, fidelity, mesh, st, status, warm = operand
         off = (jnp.zeros_like(warm[0]), jnp.zeros_like(warm[1]))
-        back = orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, st)
+        force = st["back_force"]
+        share = jnp.mean((force < 0.0).astype(force.dtype))
+        # the orbit's one cycle in every sample row: the mean over the rows is the orbit's
+        samples = jnp.broadcast_to(force, (n_samples, force.shape[0]))
         kept = (st["forces"], st["load"], st["velocity"], st["dte"], st["damper"])
-        return kept, status, off, *back
+        return kept, status, off, share, samples
 
     unstable = (state["dynamics_ok"] < 0.5) & jnp.all(jnp.isfinite(state["guess"]))
     # The branch is costly to compile (the dynamics in time): traced once, without the all-members
     # path. In a vmapped sweep whose batch mixes stable and unstable points, the unstable ones run
     # it one by one (mixed="map"): a batched select would run the 2000-cycle integration for
     # every point of the batch.
-    return cond_any_member(unstable, on_attractor, keep, operand, all_true_path=False, mixed="map")
-
-
+    picked, status, handover, share, samples = cond_any_member(
+        unstable, on_attractor, keep, operand, all_true_path=False, mixed="map"
+    )
+    power = back_flanks(pair, lubricant, surfaces, op, fidelity, mesh, st, samples)
+    power = jax.tree_util.tree_map(lambda a: jnp.where(jnp.isfinite(a), a, 0.0), power)
+    return picked, status, handover, share, power
 
 
 def finish(pair, lubricant, surfaces, op, fidelity, pending: Pending, warm_attractor=None):
@@ -286,13 +301,27 @@ def finish(pair, lubricant, surfaces, op, fidelity, pending: Pending, warm_attra
     else:
         back = orbit_back(pair, lubricant, surfaces, op, fidelity, mesh, state)
         forces, load, velocity, dte, damper = (
-            pending.forces, pending.load, pending.velocity, pending.dte, pending.damper
+            pending.forces,
+            pending.load,
+            pending.velocity,
+            pending.dte,
+            pending.damper,
         )
         status = pending.status
         handover = (jnp.zeros_like(warm_attractor[0]), jnp.zeros_like(warm_attractor[1]))
     result = assemble(
-        pair, op, mesh, forces, load, velocity, dte, status, pending.residual,
-        pending.iterations, back, damper,
+        pair,
+        op,
+        mesh,
+        forces,
+        load,
+        velocity,
+        dte,
+        status,
+        pending.residual,
+        pending.iterations,
+        back,
+        damper,
     )
     if fidelity.attractor_periods > 0:
         result = without_derivative_where(result, result.status == STATUS_ATTRACTOR)
