@@ -33,14 +33,18 @@ def inverse_involute(value: ArrayLike) -> Float[Array, "..."]:
     number of steps: exact to round-off over the range. The derivative is the implicit one,
     dα/d value = 1/tan² α, not that of the iterations.
     """
-    value = jnp.asarray(value)
+    return _newton_inverse_involute(jnp.asarray(value))
 
+
+@jax.jit
+def _newton_inverse_involute(value):
+    # A loop, not unrolled: the geometry is derived wherever it is used, and 30 unrolled steps per
+    # use were a tenth of a simulate program. Jitted so that an eager call (the pair's checks on
+    # concrete inputs) reuses one compiled loop instead of compiling one per call.
     def newton(_, alpha):
         f = jnp.tan(alpha) - alpha - value
         return jnp.clip(alpha - f / jnp.tan(alpha) ** 2, 1e-9, 1.55)
 
-    # a loop, not unrolled: the geometry is derived wherever it is used, and 30 unrolled steps
-    # per use were a tenth of a simulate program
     alpha = jnp.clip(jnp.cbrt(3.0 * value), 1e-6, 1.5)
     return jax.lax.fori_loop(0, _NEWTON_STEPS, newton, alpha)
 
