@@ -152,6 +152,7 @@ def main():
     from _report import machine, write_section
 
     trees = {"before (83eda1e)": args.old.resolve(), "now": ROOT}
+    load = os.getloadavg()[0]
     results = {name: probe(root) for name, root in trees.items()}
     if not args.skip_run:
         for name, root in trees.items():
@@ -162,7 +163,8 @@ def main():
         "",
         f"Machine: {machine()}. `Fidelity.fast()`, calibrated pair, ground, 700 N m, 2500 rpm "
         "(a stable periodic orbit); compilation cache off, each tree in a fresh process, both in "
-        "this run.",
+        f"this run; load average {load:.1f} at the start (2 cores: above 1, another job shared "
+        "the machine, and both trees' times are slower).",
         "",
         "| program | trace s | lower s | XLA compile s | StableHLO lines (while loops) | run ms |",
         "|---|---|---|---|---|---|",
