@@ -199,7 +199,7 @@ def test_coupled_rung_consistency_and_fast_preset():
 # on the paper's 25 rpm grid; all three have a stable periodic orbit (status 0), so these are
 # orbits, not attractor means. The reference is what the dynamics did not produce: the same
 # contacts at the static loads and kinematic velocities. Measured (2026-11-25, again 2026-12-01):
-# A −3.30 %, B +3.96 %, D −12.24 % (the paper fidelity −4.1, +3.4, −12.1 %, docs/figures/paper).
+# A −3.30 %, B +3.96 %, D −12.24 % (the paper fidelity −2.2, +5.7, −10.7 %, docs/figures/paper).
 # Point E (the paper +78 %) is not reproduced at this preset (README); it is tested at the
 # calibrated one (tests/paper/test_paper_calibrated.py, slow). Same inputs as the test above, so the
 # compiled simulate is reused when both run in one process.
