@@ -81,7 +81,7 @@ def record_contacts(pair, lubricant, surfaces, op, fidelity, mesh, st):
         # Evaluated exactly, the closed form follows a rattle's loads from zero to impact
         # (power laws from the orbit are extrapolated there, and carry no load to a slot the
         # orbit leaves unloaded); it tracks the EHL solver's forces within 16 % at one contact
-        # and Φ̄ within 6.1 % over the baseline sweep.
+        # and Φ̄ within 13 % over the baseline sweep.
         proxy_fid = fidelity.replace(friction="ehl_formula")
         if fidelity.friction == "ehl_smooth":  # no asperity load on the smooth rung
             surfaces = eqx.tree_at(lambda s: s.scale, surfaces, jnp.zeros_like(surfaces.scale))
