@@ -252,7 +252,10 @@ class Runner:
     def _compile(self, fid, scenario, lowered=None, lower_s=0.0):
         key = self.fid_key(fid)
         if key not in self.compiled:
-            self.compiled.clear()  # one compiled program at a time (see ``available``)
+            # one compiled program at a time (see ``available``); jax's own caches hold every
+            # program compiled so far, and their memory maps too
+            self.compiled.clear()
+            jax.clear_caches()
             t0 = time.perf_counter()
             if lowered is None:
                 lowered = SIM.lower(*scenario.inputs(self.pair), fid)
