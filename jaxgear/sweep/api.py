@@ -9,6 +9,8 @@ speed increase does: near jump regions of the dynamics it follows one branch and
 from __future__ import annotations
 
 import csv
+import os
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import equinox as eqx
@@ -221,29 +223,53 @@ def _finish_point(point, pending, warm_attractor, shared):
     return _outputs(result), handover
 
 
+def _chains(idx, continuation: bool):
+    """The flagged points as chains that must run in order: in a continuation sweep, runs of
+    neighbouring points (each continues from the one before); otherwise one point each."""
+    chains = []
+    for i in idx:
+        if continuation and chains and chains[-1][-1] == i - 1:
+            chains[-1].append(int(i))
+        else:
+            chains.append([int(i)])
+    return sorted(chains, key=len, reverse=True)
+
+
 def _second_pass(out, raw_status, inputs, shared, continuation: bool):
     """Run ``finish`` on the points whose first pass asks for it (no stable orbit, back-flank
-    strikes), one after the other, and put their outputs in place. In a continuation sweep a
-    point without a stable orbit right after another continues from that one's attractor record
-    (the paper's stepwise speed increase)."""
+    strikes) and put their outputs in place. In a continuation sweep a point without a stable
+    orbit right after another continues from that one's attractor record (the paper's stepwise
+    speed increase); chains of such points, and independent points, run side by side on the host's
+    cores (each a sequential time integration that one core runs), with the same results as one
+    after the other."""
     later = np.asarray(out.pop("later")).astype(bool) & (np.asarray(raw_status) < 2)
     pending_all = out.pop("pending", None)
     idx = np.nonzero(later)[0]
     if idx.size == 0 or pending_all is None:
         return out
     dtype = np.asarray(out["power_loss"]).dtype
-    handover = (jnp.zeros(13, dtype), jnp.zeros((), dtype))
-    previous = -2
-    for i in idx:
-        point = {k: jnp.asarray(v[i]) for k, v in inputs.items()}
-        pending = jax.tree_util.tree_map(lambda a, i=i: jnp.asarray(a[i]), pending_all)
-        warm = (
-            handover
-            if (continuation and previous == i - 1)
-            else (jnp.zeros(13, dtype), jnp.zeros((), dtype))
-        )
-        new, handover = _finish_point(point, pending, warm, shared)
-        previous = i
+    cold = (jnp.zeros(13, dtype), jnp.zeros((), dtype))
+
+    def run_chain(chain, handover):
+        results = []
+        for i in chain:
+            point = {k: jnp.asarray(v[i]) for k, v in inputs.items()}
+            pending = jax.tree_util.tree_map(lambda a, i=i: jnp.asarray(a[i]), pending_all)
+            new, handover = _finish_point(point, pending, handover, shared)
+            results.append((i, jax.block_until_ready(new)))
+        return results, handover
+
+    chains = _chains(idx, continuation)
+    # the first point alone compiles the program; the rest share it
+    results, handover = run_chain(chains[0][:1], cold)
+    rest = [(chains[0][1:], handover)] + [(c, cold) for c in chains[1:]]
+    rest = [(c, h) for c, h in rest if c]
+    if rest:
+        workers = min(len(rest), os.cpu_count() or 1)
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            for part, _ in pool.map(lambda job: run_chain(*job), rest):
+                results += part
+    for i, new in results:
         for k, v in new.items():
             arr = np.array(out[k])
             arr[i] = np.asarray(v)
