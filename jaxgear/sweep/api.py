@@ -311,6 +311,11 @@ def sweep(
 
     Returns:
         SweepResult with per-point status; every good point is kept when others fail.
+
+    Points that need the second pass (no stable periodic orbit: the attractor's time integration;
+    back-flank strikes) run it after the sweep, one compiled program for all of them; independent
+    points, and in a continuation sweep runs of neighbouring points, run side by side in threads on
+    the host's cores.
     """
     fidelity = Fidelity.fast() if fidelity is None else fidelity
     check_inputs(pair, lubricant, surfaces, op, fidelity)

@@ -158,3 +158,17 @@ def test_bad_sweep_input(base):
         sweep(pair, lub, surf, op, speeds_rpm=[1000.0], mode="serial", fidelity=FID)
     with pytest.raises(ValueError, match="torque has 2 points"):
         sweep(pair, lub, surf, op, speeds_rpm=[1.0e3, 2e3, 3e3], torque=[1.0, 2.0], fidelity=FID)
+
+
+def test_second_pass_chains_keep_neighbours_in_order():
+    # The second pass runs its chains side by side: in a continuation sweep a run of neighbouring
+    # flagged points is one chain (each continues from the one before, in order), so a chain must
+    # never be split or reordered; in a parallel sweep every point is its own chain. The longest
+    # chain comes first (it sets the second pass's wall time).
+    import importlib
+
+    api = importlib.import_module("jaxgear.sweep.api")
+    idx = np.asarray([3, 4, 5, 9, 11, 12, 20])
+    assert api._chains(idx, continuation=True) == [[3, 4, 5], [11, 12], [9], [20]]
+    assert sorted(api._chains(idx, continuation=False)) == [[int(i)] for i in idx]
+    assert api._chains(np.asarray([], dtype=int), continuation=True) == []
