@@ -80,7 +80,9 @@ def first_pass(pair, lubricant, surfaces, op, fidelity, warm: WarmStart | None =
 
 def simulate_with_state(pair, lubricant, surfaces, op, fidelity, warm: WarmStart | None = None):
     """``simulate`` that also returns the WarmStart of its converged state, with both passes in
-    one program (traceable: no checks). The quasi-static rung's WarmStart is zeros."""
+    one program (traceable: no checks). The quasi-static rung's WarmStart is zeros. Call it
+    inside ``jit`` (``eqx.filter_jit(simulate_with_state)``): run eagerly, the model's loops are
+    compiled again at every call."""
     result, warm_out, pending = first_pass(pair, lubricant, surfaces, op, fidelity, warm)
     if pending is None:
         return result, warm_out

@@ -32,6 +32,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import equinox as eqx
 import jax
 
 jax.config.update("jax_enable_x64", True)
@@ -103,6 +104,12 @@ def load_exponents():
     return rows
 
 
+# compiled once for every speed: run eagerly, the coupled model's loops compile again at each call
+# (and a long run ran out of memory maps)
+_simulate_with_state = eqx.filter_jit(simulate_with_state)
+
+
+@eqx.filter_jit
 def _attractor_cycles(op, mesh, warm):
     """Tooth forces and velocities [K, M, 2(, 2)] of the K cycles whose contacts make the means of a
     status-6 point: the record ``simulate`` took (rebuilt from its WarmStart, as in
@@ -118,11 +125,24 @@ def _attractor_cycles(op, mesh, warm):
     return rec.tooth_force[pick], rec.surface_velocity[pick]
 
 
+@eqx.filter_jit
+def _cycle_losses(mesh, loads, u_td, static):
+    """Contact loss [K, M, 2] at the given tooth loads, and at the static loads, with velocities
+    u_td; one compiled program for every speed."""
+
+    @jax.vmap
+    def cycle_loss(load, u):
+        f = formula_ehl_contact_forces(PAIR, LUB, SURF, mesh, FID, load, u[..., 0], u[..., 1], T_IN)
+        return f.power_sliding + f.power_rolling  # [M, 2]
+
+    return cycle_loss(loads, u_td), cycle_loss(jnp.broadcast_to(static, loads.shape), u_td)
+
+
 def decomposition(rpm):
     """(status, Φ̄ result, Φ̄(W_T, u_TD), Φ̄(W_sT, u_TD), Φ̄_lin, Φ̄ quasi-static, load swing) at rpm.
     At a status-6 point the tooth forces and velocities are those of the recorded attractor cycles."""
     op = _op(rpm)
-    td, warm = simulate_with_state(PAIR, LUB, SURF, op, FID)
+    td, warm = _simulate_with_state(PAIR, LUB, SURF, op, FID)
     qs = jg.simulate(PAIR, LUB, SURF, op, FID.replace(dynamics="quasi_static"))
     mesh = mesh_cycle(PAIR, op.torque, FID.n_positions, stiffness=FID.stiffness)
     static = mesh.normal_load
@@ -130,14 +150,7 @@ def decomposition(rpm):
         loads, u_td = _attractor_cycles(op, mesh, warm)
     else:
         loads, u_td = td.tooth_force[None], td.surface_velocity[None]
-
-    @jax.vmap
-    def cycle_loss(load, u):
-        f = formula_ehl_contact_forces(PAIR, LUB, SURF, mesh, FID, load, u[..., 0], u[..., 1], T_IN)
-        return f.power_sliding + f.power_rolling  # [M, 2]
-
-    phi_td = cycle_loss(loads, u_td)
-    phi_static_load = cycle_loss(jnp.broadcast_to(static, loads.shape), u_td)
+    phi_td, phi_static_load = _cycle_losses(mesh, loads, u_td, static)
     ratio = jnp.where(static > 0, loads / jnp.where(static > 0, static, 1.0), 0.0)
     phi_lin = phi_static_load * ratio
     mean = lambda x: float(jnp.mean(jnp.sum(x, axis=-1)))

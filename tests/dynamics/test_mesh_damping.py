@@ -195,7 +195,7 @@ def test_the_coupled_model_reports_the_damper_power_of_its_orbit():
     lub, surf = jg.presets.mil_l_23699(), jg.presets.ground()
     op = jg.OperatingPoint(torque=700.0, speed_rpm=2500.0, inlet_temperature=363.15)
     fid = jg.Fidelity.fast(friction="constant", n_positions=24)
-    res, warm = simulate_with_state(pair, lub, surf, op, fid)
+    res, warm = eqx.filter_jit(simulate_with_state)(pair, lub, surf, op, fid)
     assert int(res.status) == 0
     mesh = jg.mesh_cycle(pair, op.torque, fid.n_positions)
     orbit = jg.dynamic_response(
