@@ -163,8 +163,12 @@ def main():
         "",
         f"Machine: {machine()}. `Fidelity.fast()`, calibrated pair, ground, 700 N m, 2500 rpm "
         "(a stable periodic orbit); compilation cache off, each tree in a fresh process, both in "
-        f"this run; load average {load:.1f} at the start (2 cores: above 1, another job shared "
-        "the machine, and both trees' times are slower).",
+        f"this run; load average {load:.1f} at the start"
+        + (
+            " (above 1: another job shared the machine, and both trees' times are slower)."
+            if load > 1.0
+            else " (a quiet machine)."
+        ),
         "",
         "| program | trace s | lower s | XLA compile s | StableHLO lines (while loops) | run ms |",
         "|---|---|---|---|---|---|",
