@@ -11,6 +11,10 @@ cache off measures, at ``Fidelity.fast()`` on the calibrated pair (ground, 700 N
   fidelity) with ``eqx.filter_value_and_grad``: the same four figures (where the tree supports it);
 - ``jaxgear run`` cold (a fresh process, compilation cache off): wall time.
 
+This checkout is measured twice: with XLA's default CPU emitters, as the code before, and with its
+classic emitters (``--xla_cpu_use_fusion_emitters=false``), which the CLI and the tests select
+(``jaxgear.cli.enable_fast_cpu_compilation``).
+
 Writes the section ``compile`` of benchmarks/RESULTS.md. Run from the repository root:
     python benchmarks/compile.py [--old ../old] [--skip-run]
 """
@@ -106,9 +110,20 @@ print("RESULT " + json.dumps(out))
 """
 
 
-def probe(root: Path) -> dict:
+CLASSIC = "--xla_cpu_use_fusion_emitters=false"
+
+
+def _xla_flags(classic: bool) -> str:
+    """$XLA_FLAGS for a probe: the caller's, with XLA's classic CPU emitters or without."""
+    flags = os.environ.get("XLA_FLAGS", "").replace(CLASSIC, "").strip()
+    return f"{flags} {CLASSIC}".strip() if classic else flags
+
+
+def probe(root: Path, classic: bool = False) -> dict:
     env = {
         **os.environ,
+        "XLA_FLAGS": _xla_flags(classic),
+        "JAXGEAR_FAST_CPU_COMPILATION": "on" if classic else "off",
         "PYTHONPATH": str(root),
         "JAXGEAR_CACHE_DIR": "off",
         "JAX_COMPILATION_CACHE_DIR": "",
@@ -122,10 +137,12 @@ def probe(root: Path) -> dict:
     raise RuntimeError(f"probe in {root} failed:\n{proc.stderr[-3000:]}")
 
 
-def jaxgear_run(root: Path) -> float:
+def jaxgear_run(root: Path, classic: bool = False) -> float:
     exe = Path(sys.executable).with_name("jaxgear")
     with tempfile.TemporaryDirectory() as out:
         env = {**os.environ, "PYTHONPATH": str(root), "JAXGEAR_CACHE_DIR": "off"}
+        env["XLA_FLAGS"] = _xla_flags(classic)
+        env["JAXGEAR_FAST_CPU_COMPILATION"] = "on" if classic else "off"
         env["MPLBACKEND"] = "Agg"
         t0 = time.perf_counter()
         subprocess.run(
@@ -151,12 +168,18 @@ def main():
     sys.path.insert(0, str(Path(__file__).parent))
     from _report import machine, write_section
 
-    trees = {"before (83eda1e)": args.old.resolve(), "now": ROOT}
+    # (source tree, XLA's classic CPU emitters): the default emitters for both trees, and the
+    # classic ones (what the CLI and the tests select) for this one
+    trees = {
+        "before (83eda1e)": (args.old.resolve(), False),
+        "now": (ROOT, False),
+        "now, classic CPU emitters": (ROOT, True),
+    }
     load = os.getloadavg()[0]
-    results = {name: probe(root) for name, root in trees.items()}
+    results = {name: probe(*tree) for name, tree in trees.items()}
     if not args.skip_run:
-        for name, root in trees.items():
-            results[name]["jaxgear_run_s"] = jaxgear_run(root)
+        for name, tree in trees.items():
+            results[name]["jaxgear_run_s"] = jaxgear_run(*tree)
     lines = [
         "## Compilation: `simulate` and its reverse gradient against the code before "
         "(`benchmarks/compile.py`)",
@@ -218,6 +241,26 @@ def main():
             f"the same forward program's, {total(grad) / total(new['first_pass']):.1f}× the "
             "program `simulate` compiles on concrete inputs.",
         ]
+    classic = results["now, classic CPU emitters"]
+    cgrad = classic["gradient"]
+    lines += [
+        f"- XLA's classic CPU emitters (`{CLASSIC}`, what `jaxgear` and the tests select): "
+        f"`simulate`'s first call {new['simulate_call']['first_s']:.1f} → "
+        f"{classic['simulate_call']['first_s']:.1f} s; on concrete inputs trace + lower + compile "
+        f"{total(new['first_pass']):.1f} → {total(classic['first_pass']):.1f} s and run "
+        f"{new['first_pass']['run_s'] * 1e3:.0f} → {classic['first_pass']['run_s'] * 1e3:.0f} ms.",
+    ]
+    if "error" not in cgrad:
+        lines[-1] += (
+            f" The reverse gradient: compile {total(grad):.1f} → {total(cgrad):.1f} s, run "
+            f"{grad['run_s'] * 1e3:.0f} → {cgrad['run_s'] * 1e3:.0f} ms; with these emitters it "
+            f"runs {cgrad['run_s'] / classic['simulate']['run_s']:.1f}× and compiles "
+            f"{total(cgrad) / total(classic['simulate']):.1f}× the forward program inside `jit`."
+        )
+    if not args.skip_run:
+        lines[-1] += (
+            f" `jaxgear run` cold {new['jaxgear_run_s']:.0f} → {classic['jaxgear_run_s']:.0f} s."
+        )
     print("\n".join(lines))
     print(json.dumps(results, indent=1))
     write_section("compile", "\n".join(lines))

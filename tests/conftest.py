@@ -3,8 +3,11 @@ import os
 import jax
 import pytest
 
-from jaxgear.cli import enable_compilation_cache
+from jaxgear.cli import enable_compilation_cache, enable_fast_cpu_compilation
 
+# XLA's classic CPU emitters, as the CLI uses them (about half the compile time of the fusion
+# emitters on these programs); set before the first computation starts the backend.
+enable_fast_cpu_compilation()
 # Tests run in float64 (EHL needs it); the library never flips this itself.
 jax.config.update("jax_enable_x64", True)
 # Compiled programs on disk from the first test on, as `jaxgear` keeps them ($JAXGEAR_CACHE_DIR,
