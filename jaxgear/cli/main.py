@@ -51,8 +51,9 @@ _CPU_EMITTER_FLAG = "xla_cpu_use_fusion_emitters"
 
 
 def _jaxlib_knows(flag: str) -> bool:
-    """Whether this jaxlib registers the XLA flag ``flag`` (its name is in one of jaxlib's shared
-    libraries): XLA aborts the process on an unknown flag in ``$XLA_FLAGS``."""
+    """Whether this jaxlib registers the XLA flag ``flag``: its name, as a string of its own
+    (NUL before and after: not the prefix of a longer name), is in one of jaxlib's shared
+    libraries. XLA aborts the process on an unknown flag in ``$XLA_FLAGS``."""
     import glob
     import mmap
     import os
@@ -61,7 +62,7 @@ def _jaxlib_knows(flag: str) -> bool:
         import jaxlib
     except ImportError:
         return False
-    needle = flag.encode()
+    needle = b"\0" + flag.encode() + b"\0"
     for path in glob.glob(os.path.join(os.path.dirname(jaxlib.__file__), "*.so")):
         try:
             with open(path, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as m:

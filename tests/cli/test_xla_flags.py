@@ -60,3 +60,5 @@ def test_the_installed_jaxlib_runs_with_the_flag_it_is_said_to_know():
 
 def test_the_detection_does_not_accept_a_flag_xla_does_not_have():
     assert not cli_main._jaxlib_knows("xla_cpu_no_such_flag_in_any_jaxlib_0123")
+    # a prefix of a registered name is not a flag (XLA would abort on it)
+    assert not cli_main._jaxlib_knows("xla_cpu_use_fusion_emitter")
