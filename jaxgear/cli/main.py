@@ -76,9 +76,11 @@ def _jaxlib_knows(flag: str) -> bool:
 def enable_fast_cpu_compilation() -> bool:
     """Compile for the CPU with XLA's classic elemental emitters instead of its fusion emitters
     (``--xla_cpu_use_fusion_emitters=false`` appended to ``$XLA_FLAGS``). On jaxgear's programs
-    the classic emitters compile a forward ``simulate`` in about 0.6 of the time and run it about
-    0.7 of the time, with results equal to the fixed point's tolerance
-    (``benchmarks/compile.py``); the CLI and the tests use them.
+    the classic emitters compile a ``Fidelity.fast()`` ``simulate`` in about 0.6 of the time and
+    run it in about 0.7, with results equal to the fixed point's tolerance
+    (``benchmarks/compile.py``); the CLI and the tests use them. The paper fidelity's programs
+    compile more slowly with them (a tribo-dynamic point: ~1.45 times; ``benchmarks/paper_point.py``
+    with and without the flag) and run in the same time.
 
     Takes effect only before JAX starts its CPU backend (the first computation). Leaves
     ``$XLA_FLAGS`` as it is where it already names the flag (the caller's choice), and where this
