@@ -48,6 +48,8 @@ def enable_float64() -> None:
 
 # XLA's CPU flag that selects its classic elemental emitters over the newer fusion emitters
 _CPU_EMITTER_FLAG = "xla_cpu_use_fusion_emitters"
+# the --fidelity choices whose programs compile faster with XLA's default CPU emitters
+_PAPER_FIDELITIES = ("paper", "paper_calibrated")
 
 
 def _jaxlib_knows(flag: str) -> bool:
@@ -78,9 +80,10 @@ def enable_fast_cpu_compilation() -> bool:
     (``--xla_cpu_use_fusion_emitters=false`` appended to ``$XLA_FLAGS``). On jaxgear's programs
     the classic emitters compile a ``Fidelity.fast()`` ``simulate`` in about 0.6 of the time and
     run it in about 0.7, with results equal to the fixed point's tolerance
-    (``benchmarks/compile.py``); the CLI and the tests use them. The paper fidelity's programs
-    compile more slowly with them (a tribo-dynamic point: ~1.45 times; ``benchmarks/paper_point.py``
-    with and without the flag) and run in the same time.
+    (``benchmarks/compile.py``); the tests use them, and the CLI does unless its ``--fidelity``
+    is ``paper`` or ``paper_calibrated``: the paper fidelity's programs compile more slowly with
+    them (a tribo-dynamic point: ~1.45 times; ``benchmarks/paper_point.py`` with and without the
+    flag) and run in the same time.
 
     Takes effect only before JAX starts its CPU backend (the first computation). Leaves
     ``$XLA_FLAGS`` as it is where it already names the flag (the caller's choice), and where this
@@ -123,7 +126,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 0
-    enable_fast_cpu_compilation()
+    # the paper fidelity's programs compile more slowly with the classic emitters (above)
+    if getattr(args, "fidelity", None) not in _PAPER_FIDELITIES:
+        enable_fast_cpu_compilation()
     enable_float64()
     enable_compilation_cache()
     try:

@@ -62,3 +62,31 @@ def test_the_detection_does_not_accept_a_flag_xla_does_not_have():
     assert not cli_main._jaxlib_knows("xla_cpu_no_such_flag_in_any_jaxlib_0123")
     # a prefix of a registered name is not a flag (XLA would abort on it)
     assert not cli_main._jaxlib_knows("xla_cpu_use_fusion_emitter")
+
+
+def _flags_of_a_cli_call(argv, monkeypatch):
+    """$XLA_FLAGS after ``jaxgear ARGV`` chose its emitters (the command itself not run)."""
+    monkeypatch.setenv("XLA_FLAGS", "")
+    monkeypatch.delenv("JAXGEAR_FAST_CPU_COMPILATION", raising=False)
+    monkeypatch.setattr(cli_main, "_jaxlib_knows", lambda flag: True)
+    monkeypatch.setattr(cli_main, "enable_float64", lambda: None)
+    monkeypatch.setattr(cli_main, "enable_compilation_cache", lambda: None)
+    args = cli_main.build_parser().parse_args(argv)
+    args.func = lambda a: 0
+
+    class Parsed:
+        def parse_args(self, argv=None):
+            return args
+
+    with monkeypatch.context() as m:
+        m.setattr(cli_main, "build_parser", Parsed)
+        assert cli_main.main(argv) == 0
+    return os.environ["XLA_FLAGS"]
+
+
+def test_the_cli_selects_the_classic_emitters_except_at_the_paper_fidelity(monkeypatch):
+    # the paper fidelity's programs compile ~1.45x slower with them (benchmarks/paper_point.py)
+    assert FLAG in _flags_of_a_cli_call(["figures", "--fidelity", "fast"], monkeypatch)
+    assert FLAG in _flags_of_a_cli_call(["run"], monkeypatch)
+    for name in ("paper", "paper_calibrated"):
+        assert FLAG not in _flags_of_a_cli_call(["figures", "--fidelity", name], monkeypatch)
