@@ -116,6 +116,26 @@ def deterministic_film():
 # --------------------------------------------------------------------------------------------------
 # Statistical (Greenwood-Tripp) thermal mixed film
 # --------------------------------------------------------------------------------------------------
+def test_a_warm_statistical_thermal_solve_reaches_the_cold_solves_film_on_257_nodes(
+    statistical_film,
+):
+    # A warm solve (what every fixed-point iteration and passage step after the first runs) from
+    # the 500 rpm film at 510 rpm ends where a cold solve at 510 rpm does: the same discrete
+    # film, so its loss equals the cold one's to the solvers' tolerances (measured 5e-16
+    # relative), and its temperature check passes. A temperature iteration that ran its first
+    # solve as its first step failed this on 257 nodes (not on 65): the warm solve ended
+    # unconverged, 0.47 K off its temperature tolerance, its loss 0.05 % off.
+    sol, _, surf = statistical_film
+    c = gear_contact(rpm=510.0)
+    warm = jg.solve_ehl(c, LUB, STAT_THERMAL, surf, initial=sol)
+    cold = jg.solve_ehl(c, LUB, STAT_THERMAL, surf)
+    assert bool(warm.converged), (float(warm.residual), float(warm.thermal_residual))
+    assert bool(cold.converged)
+    assert float(warm.thermal_residual) < 0.01 * float(jnp.max(warm.temperature) - 363.15)
+    np.testing.assert_allclose(float(warm.power_loss), float(cold.power_loss), rtol=1e-6)
+    assert int(warm.iterations) < int(cold.iterations)
+
+
 def test_statistical_thermal_heat_equals_friction_work(statistical_film):
     sol, c, surf = statistical_film
     f = _fields(sol, c, float(surf.composite_rq))

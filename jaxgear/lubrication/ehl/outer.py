@@ -61,18 +61,14 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
     """One solve (steady or one transient step); thermal when ``model.thermal``.
 
     Returns (solution, temperatures or None)."""
+    u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0)
+    sol = _postprocess(model, mixed, inp, u, res, it, ok)
+    if not model.thermal:
+        return sol, None
     n_outer = _thermal_iterations(model, mixed)
     max_step = _DETERMINISTIC_TEMPERATURE_STEP if mixed == "deterministic" else None
     # a deterministic film's re-solves know the temperatures their start was solved at
     hot = model.thermal and mixed == "deterministic" and model.temperature_steps > 0
-    # a warm solve whose re-solves are the same solve (same attempts, same inputs' structure): the
-    # first solve is the outer iteration's first step, and the Newton solve is traced once
-    one_trace = model.thermal and warm and not hot
-    if not one_trace:
-        u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0)
-        sol = _postprocess(model, mixed, inp, u, res, it, ok)
-        if not model.thermal:
-            return sol, None
     if hot:
         inp = dataclasses.replace(inp, temperature_rise_previous=inp.temperature_rise)
 
@@ -145,61 +141,14 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
         ), None
 
     zero = jnp.zeros_like(inp.temperature_rise)
-    relax0 = (jnp.ones((), zero.dtype), zero, jnp.asarray(False))
-    if one_trace:
-        sol, inp_last = _solve_and_update(
-            model, mixed, inp, (init_x, init_p, init_h0), relax0, n_outer, updates, solids,
-            transient,
-        )  # fmt: skip
-    else:
-        init = (sol, inp, jnp.asarray(False), relax0)
-        (sol, inp_last, _, _), _ = jax.lax.scan(picard, init, None, length=n_outer)
+    init = (sol, inp, jnp.asarray(False), (jnp.ones((), zero.dtype), zero, jnp.asarray(False)))
+    (sol, inp_last, _, _), _ = jax.lax.scan(picard, init, None, length=n_outer)
     temps = _finite_temperatures(_temperatures(inp_last, sol, solids, transient))
     change = jnp.max(jnp.abs(temps.film_mean - inp_last.temperature_rise))
     change = jnp.where(jnp.isfinite(change), change, jnp.finfo(change.dtype).max)
     thermal_ok = thermal_settled(change, temps.film_mean)
     sol = eqx.tree_at(lambda s: s.converged, sol, sol.converged & thermal_ok)
     return _with_temperatures(sol, temps, inp.contact.inlet_temperature, change), temps
-
-
-def _solve_and_update(model, mixed, inp, args, relax, n_outer, updates, solids, transient):
-    """The outer iteration of a warm thermal solve with its first solve as its first step:
-    ``n_outer`` + 1 steps of (Reynolds at the step's temperatures, warm started; the temperatures
-    its heat implies), ending once they agree with those it was solved with, so the Newton solve
-    appears once in the program. The same solves and updates, in the same order, as a first solve
-    followed by ``n_outer`` updates and re-solves. Returns (the last solution, the inputs it was
-    solved with)."""
-    det = mixed == "deterministic"
-
-    def solve(op):
-        sol_prev, _, inp_k, args_k, relax, first = op
-        u, res, it, ok = _solve_core(model, True, mixed, inp_k, *args_k)
-        new = _postprocess(model, mixed, inp_k, u, res, it, ok)
-        if sol_prev is not None:  # None: the placeholder's structure is being found
-            new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol_prev.iterations)
-        inp_next, settled, relax_next = updates(new, inp_k, solids, transient, relax)
-        # a deterministic film's failed re-solve ends the iteration (``_solve_impl``); a failed
-        # first solve still gets its updates
-        stop = (~new.converged & ~first) if det else jnp.asarray(False)
-        return new, inp_k, inp_next, _warm_args(new, det), relax_next, settled | stop
-
-    def keep(op):
-        sol_prev, inp_solved, inp_k, args_k, relax, _ = op
-        return sol_prev, inp_solved, inp_k, args_k, relax, jnp.asarray(True)
-
-    def step(carry, _):
-        *op, done = carry
-        out = jax.lax.cond(done, keep, solve, tuple(op))
-        return (*out[:5], jnp.asarray(False), out[5]), None
-
-    first = jnp.asarray(True)
-    # what the first step replaces: a solution of the right structure, never read but for its
-    # iteration count (0)
-    shape = eqx.filter_eval_shape(lambda: solve((None, inp, inp, args, relax, first))[0])
-    placeholder = jax.tree_util.tree_map(lambda a: jnp.zeros(a.shape, a.dtype), shape)
-    init = (placeholder, inp, inp, args, relax, first, jnp.asarray(False))
-    (sol, inp_solved, *_), _ = jax.lax.scan(step, init, None, length=n_outer + 1)
-    return sol, inp_solved
 
 
 def _thermal_iterations(model: EHLModel, mixed: str) -> int:
