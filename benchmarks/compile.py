@@ -12,8 +12,8 @@ cache off measures, at ``Fidelity.fast()`` on the calibrated pair (ground, 700 N
 - ``jaxgear run`` cold (a fresh process, compilation cache off): wall time.
 
 This checkout is measured twice: with XLA's default CPU emitters, as the code before, and with its
-classic emitters (``--xla_cpu_use_fusion_emitters=false``), which the CLI and the tests select
-(``jaxgear.cli.enable_fast_cpu_compilation``).
+classic emitters (``--xla_cpu_use_fusion_emitters=false``), which the tests and the CLI (but at
+the paper fidelity) select (``jaxgear.cli.enable_fast_cpu_compilation``).
 
 Writes the section ``compile`` of benchmarks/RESULTS.md. Run from the repository root:
     python benchmarks/compile.py [--old ../old] [--skip-run]
