@@ -623,3 +623,26 @@ def test_bounded_temperatures_of_a_failed_solve_keep_the_lubricant_finite(lub):
             assert bool(jnp.all(lub.density_at(p, t) > 0.0))
         assert bool(jnp.all(jnp.isfinite(lub.pressure_viscosity_coefficient(t))))
         assert bool(jnp.all(lub.density_at(0.0, t, compressible=False) > 0.0))
+
+
+def test_a_thermal_solve_traces_its_newton_solve_once():
+    # Compile time: a thermal solve runs its first solve as the first step of the temperature
+    # iteration (a cold solve: the warm solve with its warm attempts skipped), so its Newton solve
+    # (the custom-JVP ``_solve_core``) enters the program once, cold or warm. Counted in the traced
+    # programs (no compilation), 65 nodes, the statistical film of Fidelity.paper().
+    c = gear_contact(rpm=3500.0)
+    model = jg.EHLModel(n_nodes=65, mixed="statistical", thermal=True)
+    cold = jg.solve_ehl(c, LUB, model, ground())
+    assert bool(cold.converged)
+
+    def newton_solves(initial):
+        jaxpr = jax.make_jaxpr(lambda c: jg.solve_ehl(c, LUB, model, ground(), initial=initial).p)
+        return str(jaxpr(c)).count("name=_solve_core")
+
+    assert newton_solves(None) == 1
+    assert newton_solves(cold) == 1
+    # and the warm solve from the cold one's solution is that solution (the same discrete film)
+    warm = jg.solve_ehl(c, LUB, model, ground(), initial=cold)
+    assert bool(warm.converged)
+    np.testing.assert_allclose(warm.power_loss, cold.power_loss, rtol=1e-6)
+    assert int(warm.iterations) < int(cold.iterations)

@@ -59,11 +59,16 @@ _HOT = -4  # attempt kind: the continuation in the temperatures of a re-solve (d
 
 
 @functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2))
-def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, init_p, init_h0):
+def _solve_core(
+    model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, init_p, init_h0, skip_warm
+):
     """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats.
 
     The fine-grid Newton loop appears once in the program: a warm solve is a scan over two attempts
-    (the warm start, then, only if that failed, the cold start), so compile time does not double."""
+    (the warm start, then, only if that failed, the cold start), so compile time does not double.
+    ``skip_warm`` (a traced scalar; > 0.5: yes) makes a warm solve a cold one: its warm attempts are
+    skipped and its cold ones run as a cold solve runs them, so a cold solve and its warm re-solves
+    can share one trace (``outer._solve_and_update``)."""
     if mixed == "deterministic":
         inp = dataclasses.replace(inp, rough=True)
     sc, fine = _fine_level(model, inp)
@@ -206,19 +211,21 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
 
         # further relaxed rounds only after a Newton that got close (see ``_RELAX_GIVE_UP``)
         hopeless = ((kind == _RETRY) | (kind == _HALF)) & ~(res < _RELAX_GIVE_UP)
+        warm_kind = (kind == 0) | (kind == _RETRY) | (kind == _HALF) | (kind == _HOT)
+        # a warm solve told to be cold skips its warm attempts
+        skipped = warm_kind & (skip_warm > 0.5)
         # a failed roughness continuation ends the cold attempts, not the pseudo-time march
-        done = ok | (stop & (kind != _PSEUDO)) | hopeless
+        done = ok | (stop & (kind != _PSEUDO)) | hopeless | skipped
         operand = (kind, u, inp, u_start)
         start, k0, repeat = cond_any_member(done | (kind == 0), keep, prepare, operand)
         start = jnp.where(kind == 0, u_warm, start)
         budget = model.warm_iterations if warm else model.max_iterations
-        warm_kind = (kind == 0) | (kind == _RETRY) | (kind == _HALF) | (kind == _HOT)
         max_iter = jnp.where(done, 0, jnp.where(warm_kind, budget, model.max_iterations))
         u1, res1, k1, ok1 = _newton(fine, start, 1.0, max_iter)
         u1 = jnp.where(done, u, u1)
         res1 = jnp.where(done, res, res1)
         # smooth EHL: a closed film is a failure: try the next attempt (mixed: it is contact)
-        ok1 = ok | ok1
+        ok1 = ok | (ok1 & ~skipped)
         if mixed == "smooth":
             ok1 = ok1 & (jnp.min(fine.film(u1)) > 0.0)
         return (u1, res1, it + k0 + k1, ok1, stop | repeat), None
@@ -239,9 +246,9 @@ def _solve_core(model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, 
 
 @_solve_core.defjvp
 def _solve_core_jvp(model, warm, mixed, primals, tangents):
-    inp, init_x, init_p, init_h0 = primals
+    inp, init_x, init_p, init_h0, skip_warm = primals
     d_inp = tangents[0]
-    u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0)
+    u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0, skip_warm)
     if mixed == "deterministic":  # the system the solve solved (``EHLModel.smoothing``)
         inp = dataclasses.replace(inp, rough=True)
         d_inp = dataclasses.replace(d_inp, rough=True)

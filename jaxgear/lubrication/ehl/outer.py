@@ -61,14 +61,20 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
     """One solve (steady or one transient step); thermal when ``model.thermal``.
 
     Returns (solution, temperatures or None)."""
-    u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0)
-    sol = _postprocess(model, mixed, inp, u, res, it, ok)
-    if not model.thermal:
-        return sol, None
     n_outer = _thermal_iterations(model, mixed)
     max_step = _DETERMINISTIC_TEMPERATURE_STEP if mixed == "deterministic" else None
     # a deterministic film's re-solves know the temperatures their start was solved at
     hot = model.thermal and mixed == "deterministic" and model.temperature_steps > 0
+    # a thermal solve whose re-solves are the same solve (same attempts, same inputs' structure):
+    # the first solve is the outer iteration's first step (a cold one: the warm solve with its warm
+    # attempts skipped), and the Newton solve is traced once
+    one_trace = model.thermal and not hot
+    if not one_trace:
+        no = jnp.zeros((), init_h0.dtype)
+        u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0, no)
+        sol = _postprocess(model, mixed, inp, u, res, it, ok)
+        if not model.thermal:
+            return sol, None
     if hot:
         inp = dataclasses.replace(inp, temperature_rise_previous=inp.temperature_rise)
 
@@ -106,7 +112,7 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
     def solve(op):
         sol, _, inp_next, relax = op
         args = _warm_args(sol, mixed == "deterministic")
-        u, res, it, ok = _solve_core(model, True, mixed, inp_next, *args)
+        u, res, it, ok = _solve_core(model, True, mixed, inp_next, *args, jnp.zeros(()))
         new = _postprocess(model, mixed, inp_next, u, res, it, ok)
         new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol.iterations)
         # a deterministic film whose re-solve failed (every attempt) ends the iteration, reported
@@ -141,14 +147,108 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
         ), None
 
     zero = jnp.zeros_like(inp.temperature_rise)
-    init = (sol, inp, jnp.asarray(False), (jnp.ones((), zero.dtype), zero, jnp.asarray(False)))
-    (sol, inp_last, _, _), _ = jax.lax.scan(picard, init, None, length=n_outer)
+    relax0 = (jnp.ones((), zero.dtype), zero, jnp.asarray(False))
+    if one_trace:
+        sol, inp_last = _solve_and_update(
+            model, mixed, inp, (init_x, init_p, init_h0), relax0, n_outer, updates, solids,
+            transient, cold=not warm,
+        )  # fmt: skip
+    else:
+        init = (sol, inp, jnp.asarray(False), relax0)
+        (sol, inp_last, _, _), _ = jax.lax.scan(picard, init, None, length=n_outer)
     temps = _finite_temperatures(_temperatures(inp_last, sol, solids, transient))
     change = jnp.max(jnp.abs(temps.film_mean - inp_last.temperature_rise))
     change = jnp.where(jnp.isfinite(change), change, jnp.finfo(change.dtype).max)
     thermal_ok = thermal_settled(change, temps.film_mean)
     sol = eqx.tree_at(lambda s: s.converged, sol, sol.converged & thermal_ok)
     return _with_temperatures(sol, temps, inp.contact.inlet_temperature, change), temps
+
+
+def _solve_and_update(
+    model, mixed, inp, args, relax, n_outer, updates, solids, transient, cold=False
+):
+    """The outer iteration of a thermal solve with its first solve as its first step:
+    ``n_outer`` + 1 steps of (the temperatures the last solution implies, none before the first;
+    Reynolds at them, warm started), ending once they agree with those it was solved with, so the
+    Newton solve appears once in the program. The same solves and updates, in the same order, as a
+    first solve followed by ``n_outer`` updates and re-solves. ``cold``: the first solve is a cold
+    one, the warm solve with its warm attempts skipped (``args``, the cold solve's placeholders,
+    are then replaced by a warm start's, never read). Returns (the last solution, the inputs it
+    was solved with).
+
+    The temperatures are updated at the start of a step, outside the branch that solves: with the
+    update after the solve in the same branch, XLA's optimised CPU code evaluated the temperatures
+    of a 257-node statistical film differently inside the loop than after it (film mean rises 0.4 %
+    apart on identical inputs, equal with ``--xla_backend_optimization_level=0``), and the
+    iteration settled on the wrong temperatures."""
+    det = mixed == "deterministic"
+
+    def solve(sol_prev, inp_k, args_k, first):
+        skip_warm = (first & cold).astype(inp_k.temperature_rise.dtype)
+        u, res, it, ok = _solve_core(model, True, mixed, inp_k, *args_k, skip_warm)
+        new = _postprocess(model, mixed, inp_k, u, res, it, ok)
+        if sol_prev is not None:  # None: the placeholder's structure is being found
+            new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol_prev.iterations)
+        # a deterministic film's failed re-solve ends the iteration (``_solve_impl``); a failed
+        # first solve still gets its updates
+        stop = (~new.converged & ~first) if det else jnp.asarray(False)
+        return new, stop
+
+    def begin(op):  # the first step: the caller's inputs and start
+        _, inp_k, relax = op
+        return inp_k, jnp.asarray(False), relax, args
+
+    def update(op):
+        sol, inp_k, relax = op
+        inp_next, settled, relax_next = updates(sol, inp_k, solids, transient, relax)
+        return inp_next, settled, relax_next, _warm_args(sol, det)
+
+    def step(op):
+        sol, inp_k, relax, first = op
+        # ``first`` is the same for every member of a vmapped batch: a cond, never a select, so the
+        # placeholder's update is never evaluated
+        inp_next, settled, relax_next, args_k = jax.lax.cond(
+            first, begin, update, (sol, inp_k, relax)
+        )
+
+        def stay(op):  # ``sol`` is the answer for the inputs it was solved with: keep both
+            return op[0], op[1], jnp.asarray(True), relax
+
+        def resolve(op):
+            new, stop = solve(op[0], inp_next, args_k, first)
+            return new, inp_next, stop, relax_next
+
+        return jax.lax.cond(settled, stay, resolve, (sol, inp_k))
+
+    def picard(carry, _):
+        sol, inp_k, done, relax, first = carry
+        out = jax.lax.cond(
+            done,
+            lambda op: (op[0], op[1], jnp.asarray(True), op[2]),
+            step,
+            (sol, inp_k, relax, first),
+        )
+        return (*out, jnp.asarray(False)), None
+
+    first = jnp.asarray(True)
+    # what the first step replaces: a solution of the right structure, never read but for its
+    # iteration count (0)
+    if cold:
+
+        def cold_solution():
+            no = jnp.zeros((), inp.temperature_rise.dtype)
+            u, res, it, ok = _solve_core(model, False, mixed, inp, *args, no)
+            return _postprocess(model, mixed, inp, u, res, it, ok)
+
+        shape = eqx.filter_eval_shape(cold_solution)
+    else:
+        shape = eqx.filter_eval_shape(lambda: solve(None, inp, args, first)[0])
+    placeholder = jax.tree_util.tree_map(lambda a: jnp.zeros(a.shape, a.dtype), shape)
+    if cold:  # a warm start of the right structure (guarded: finite), never read
+        args = _warm_args(placeholder, det)
+    init = (placeholder, inp, jnp.asarray(False), relax, first)
+    (sol, inp_solved, *_), _ = jax.lax.scan(picard, init, None, length=n_outer + 1)
+    return sol, inp_solved
 
 
 def _thermal_iterations(model: EHLModel, mixed: str) -> int:
