@@ -57,17 +57,23 @@ _RELAX_GIVE_UP = 0.1
 _PSEUDO = -3  # attempt kind: the pseudo-time march (deterministic roughness, after the cold ones)
 _HOT = -4  # attempt kind: the continuation in the temperatures of a re-solve (deterministic film)
 
+# which attempts ``_solve_core`` skips (its traced ``skip``): none; the warm ones (a cold solve);
+# the continuation in the temperatures (a deterministic film's first solve)
+SKIP_NONE, SKIP_WARM, SKIP_HOT = 0.0, 1.0, 2.0
+
 
 @functools.partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2))
 def _solve_core(
-    model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, init_p, init_h0, skip_warm
+    model: EHLModel, warm: bool, mixed: bool, inp: _Inputs, init_x, init_p, init_h0, skip
 ):
     """u* = [P, H0] on the fine grid, plus (residual, iterations, converged) as floats.
 
     The fine-grid Newton loop appears once in the program: a warm solve is a scan over two attempts
     (the warm start, then, only if that failed, the cold start), so compile time does not double.
-    ``skip_warm`` (a traced scalar; > 0.5: yes) makes a warm solve a cold one: its warm attempts are
-    skipped and its cold ones run as a cold solve runs them, so a cold solve and its warm re-solves
+    ``skip`` (a traced scalar) skips attempts of a warm solve: ``SKIP_WARM`` makes it a cold one
+    (its warm attempts skipped, its cold ones run as a cold solve runs them), ``SKIP_HOT`` makes a
+    deterministic film's re-solve (``inp.temperature_rise_previous`` given) its first solve (no
+    continuation in the temperatures), ``SKIP_NONE`` skips none; so a first solve and its re-solves
     can share one trace (``outer._solve_and_update``)."""
     if mixed == "deterministic":
         inp = dataclasses.replace(inp, rough=True)
@@ -213,7 +219,7 @@ def _solve_core(
         hopeless = ((kind == _RETRY) | (kind == _HALF)) & ~(res < _RELAX_GIVE_UP)
         warm_kind = (kind == 0) | (kind == _RETRY) | (kind == _HALF) | (kind == _HOT)
         # a warm solve told to be cold skips its warm attempts
-        skipped = warm_kind & (skip_warm > 0.5)
+        skipped = (warm_kind & (skip == SKIP_WARM)) | ((kind == _HOT) & (skip == SKIP_HOT))
         # a failed roughness continuation ends the cold attempts, not the pseudo-time march
         done = ok | (stop & (kind != _PSEUDO)) | hopeless | skipped
         operand = (kind, u, inp, u_start)
@@ -246,9 +252,9 @@ def _solve_core(
 
 @_solve_core.defjvp
 def _solve_core_jvp(model, warm, mixed, primals, tangents):
-    inp, init_x, init_p, init_h0, skip_warm = primals
+    inp, init_x, init_p, init_h0, skip = primals
     d_inp = tangents[0]
-    u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0, skip_warm)
+    u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0, skip)
     if mixed == "deterministic":  # the system the solve solved (``EHLModel.smoothing``)
         inp = dataclasses.replace(inp, rough=True)
         d_inp = dataclasses.replace(d_inp, rough=True)

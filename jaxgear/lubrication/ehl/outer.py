@@ -11,7 +11,7 @@ import jax
 import jax.numpy as jnp
 
 from .. import thermal as thermal_mod
-from .core import _postprocess, _solve_core
+from .core import SKIP_HOT, SKIP_NONE, SKIP_WARM, _postprocess, _solve_core
 from .model import EHLModel, _Inputs
 from .solution import EHLSolution
 from .starts import _warm_args
@@ -65,16 +65,10 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
     max_step = _DETERMINISTIC_TEMPERATURE_STEP if mixed == "deterministic" else None
     # a deterministic film's re-solves know the temperatures their start was solved at
     hot = model.thermal and mixed == "deterministic" and model.temperature_steps > 0
-    # a thermal solve whose re-solves are the same solve (same attempts, same inputs' structure):
-    # the first solve is the outer iteration's first step (a cold one: the warm solve with its warm
-    # attempts skipped), and the Newton solve is traced once
-    one_trace = model.thermal and not hot
-    if not one_trace:
-        no = jnp.zeros((), init_h0.dtype)
-        u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0, no)
-        sol = _postprocess(model, mixed, inp, u, res, it, ok)
-        if not model.thermal:
-            return sol, None
+    if not model.thermal:
+        none = jnp.asarray(SKIP_NONE, init_h0.dtype)
+        u, res, it, ok = _solve_core(model, warm, mixed, inp, init_x, init_p, init_h0, none)
+        return _postprocess(model, mixed, inp, u, res, it, ok), None
     if hot:
         inp = dataclasses.replace(inp, temperature_rise_previous=inp.temperature_rise)
 
@@ -99,63 +93,12 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
             inp_next = eqx.tree_at(lambda i: i.temperature_rise_previous, inp_next, previous)
         return inp_next, settled, relax
 
-    # Outer (Picard) iteration: Reynolds at fixed temperatures (Newton, warm started), then the
-    # temperatures of its heat source. It stops once they agree with those the film was solved
-    # with (the remaining steps are skipped by lax.cond: no work when solved one contact at a time;
-    # a scan, not a while loop, so that reverse-mode differentiation works). Under vmap the skipped
-    # steps still run; the vmap-lazy ``cond_any_member`` is slower here (30-40 % on a parallel
-    # thermal transient mixed sweep), so it is kept to the solver's fallback attempts, where it
-    # pays.
-    def stay(op):
-        return op[0], op[1], jnp.asarray(True), op[2]
-
-    def solve(op):
-        sol, _, inp_next, relax = op
-        args = _warm_args(sol, mixed == "deterministic")
-        u, res, it, ok = _solve_core(model, True, mixed, inp_next, *args, jnp.zeros(()))
-        new = _postprocess(model, mixed, inp_next, u, res, it, ok)
-        new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol.iterations)
-        # a deterministic film whose re-solve failed (every attempt) ends the iteration, reported
-        # not converged: the temperatures of a film that is not a Reynolds solution lead nowhere,
-        # and each further re-solve runs every cold attempt (~500 Newton iterations each): a
-        # thermal engagement along the path costs 15-30 % less than going on to the last update,
-        # with about as many steps converged. A failed first solve still gets its updates: new
-        # temperatures can make it solvable. Not two failed solves in a row as the stop: that
-        # cascades (the failed step's successor restarts steady, and its restarts can fail in
-        # turn).
-        stop = ~new.converged if mixed == "deterministic" else jnp.asarray(False)
-        return new, inp_next, stop, relax
-
-    def step(op):
-        sol, inp_k, relax, solids, transient = op
-        inp_next, settled, relax_next = updates(sol, inp_k, solids, transient, relax)
-        # settled: ``sol`` is the answer for the inputs it was solved with; keep both
-        return jax.lax.cond(
-            settled,
-            lambda op: stay((op[0], op[1], relax)),
-            solve,
-            (sol, inp_k, inp_next, relax_next),
-        )
-
-    def picard(carry, _):
-        sol, inp_k, done, relax = carry
-        return jax.lax.cond(
-            done,
-            lambda op: (op[0], op[1], jnp.asarray(True), op[2]),
-            step,
-            (sol, inp_k, relax, solids, transient),
-        ), None
-
     zero = jnp.zeros_like(inp.temperature_rise)
     relax0 = (jnp.ones((), zero.dtype), zero, jnp.asarray(False))
-    if one_trace:
-        sol, inp_last = _solve_and_update(
-            model, mixed, inp, (init_x, init_p, init_h0), relax0, n_outer, updates, solids,
-            transient, cold=not warm,
-        )  # fmt: skip
-    else:
-        init = (sol, inp, jnp.asarray(False), relax0)
-        (sol, inp_last, _, _), _ = jax.lax.scan(picard, init, None, length=n_outer)
+    sol, inp_last = _solve_and_update(
+        model, mixed, inp, (init_x, init_p, init_h0), relax0, n_outer, updates, solids, transient,
+        cold=not warm, hot=hot,
+    )  # fmt: skip
     temps = _finite_temperatures(_temperatures(inp_last, sol, solids, transient))
     change = jnp.max(jnp.abs(temps.film_mean - inp_last.temperature_rise))
     change = jnp.where(jnp.isfinite(change), change, jnp.finfo(change.dtype).max)
@@ -165,16 +108,22 @@ def _solve_impl(model, warm, mixed, inp, init_x, init_p, init_h0, solids, transi
 
 
 def _solve_and_update(
-    model, mixed, inp, args, relax, n_outer, updates, solids, transient, cold=False
+    model, mixed, inp, args, relax, n_outer, updates, solids, transient, cold, hot
 ):
-    """The outer iteration of a thermal solve with its first solve as its first step:
+    """The outer (Picard) iteration of a thermal solve, its first solve its first step:
     ``n_outer`` + 1 steps of (the temperatures the last solution implies, none before the first;
-    Reynolds at them, warm started), ending once they agree with those it was solved with, so the
-    Newton solve appears once in the program. The same solves and updates, in the same order, as a
-    first solve followed by ``n_outer`` updates and re-solves. ``cold``: the first solve is a cold
-    one, the warm solve with its warm attempts skipped (``args``, the cold solve's placeholders,
-    are then replaced by a warm start's, never read). Returns (the last solution, the inputs it
-    was solved with).
+    Reynolds at them, Newton warm started from that solution), ending once they agree with those
+    it was solved with, so the Newton solve appears once in the program. The remaining steps are
+    skipped by lax.cond: no work when solved one contact at a time; a scan, not a while loop, so
+    that reverse-mode differentiation works. Under vmap the skipped steps still run; the vmap-lazy
+    ``cond_any_member`` is slower here (30-40 % on a parallel thermal transient mixed sweep), so
+    it is kept to the solver's fallback attempts, where it pays.
+
+    ``cold``: the first solve is a cold one, the warm solve with its warm attempts skipped
+    (``args``, the cold solve's placeholders, are then replaced by a warm start's, never read).
+    ``hot``: a deterministic film's re-solves continue in the temperatures from the last solve's
+    (``inp.temperature_rise_previous``); its first solve does not. Returns (the last solution, the
+    inputs it was solved with).
 
     The temperatures are updated at the start of a step, outside the branch that solves: with the
     update after the solve in the same branch, XLA's optimised CPU code evaluated the temperatures
@@ -183,14 +132,22 @@ def _solve_and_update(
     iteration settled on the wrong temperatures."""
     det = mixed == "deterministic"
 
+    first_skip = SKIP_WARM if cold else (SKIP_HOT if hot else SKIP_NONE)
+
     def solve(sol_prev, inp_k, args_k, first):
-        skip_warm = (first & cold).astype(inp_k.temperature_rise.dtype)
-        u, res, it, ok = _solve_core(model, True, mixed, inp_k, *args_k, skip_warm)
+        skip = jnp.where(first, first_skip, SKIP_NONE).astype(inp_k.temperature_rise.dtype)
+        u, res, it, ok = _solve_core(model, True, mixed, inp_k, *args_k, skip)
         new = _postprocess(model, mixed, inp_k, u, res, it, ok)
         if sol_prev is not None:  # None: the placeholder's structure is being found
             new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol_prev.iterations)
-        # a deterministic film's failed re-solve ends the iteration (``_solve_impl``); a failed
-        # first solve still gets its updates
+        # a deterministic film whose re-solve failed (every attempt) ends the iteration, reported
+        # not converged: the temperatures of a film that is not a Reynolds solution lead nowhere,
+        # and each further re-solve runs every cold attempt (~500 Newton iterations each): a
+        # thermal engagement along the path costs 15-30 % less than going on to the last update,
+        # with about as many steps converged. A failed first solve still gets its updates: new
+        # temperatures can make it solvable. Not two failed solves in a row as the stop: that
+        # cascades (the failed step's successor restarts steady, and its restarts can fail in
+        # turn).
         stop = (~new.converged & ~first) if det else jnp.asarray(False)
         return new, stop
 
@@ -236,8 +193,8 @@ def _solve_and_update(
     if cold:
 
         def cold_solution():
-            no = jnp.zeros((), inp.temperature_rise.dtype)
-            u, res, it, ok = _solve_core(model, False, mixed, inp, *args, no)
+            none = jnp.asarray(SKIP_NONE, inp.temperature_rise.dtype)
+            u, res, it, ok = _solve_core(model, False, mixed, inp, *args, none)
             return _postprocess(model, mixed, inp, u, res, it, ok)
 
         shape = eqx.filter_eval_shape(cold_solution)
