@@ -118,77 +118,91 @@ class EarlyExitGMRES(lx.AbstractLinearSolver):
 
         b = flat_b / flat_d
         n, m = b.shape[0], min(self.restart, b.shape[0])
-        tol = self.rtol * jnp.linalg.norm(b) + self.atol
+        b_norm = jnp.linalg.norm(b)
+        tol = self.rtol * b_norm + self.atol
 
-        def cycle(x0):
-            r0 = b - mv(x0)
-            beta = jnp.linalg.norm(r0)
-            basis = jnp.zeros((m + 1, n), dtype).at[0].set(r0 / jnp.where(beta > 0, beta, 1.0))
-            hess = jnp.zeros((m + 1, m), dtype)
-            cs, sn = jnp.ones(m, dtype), jnp.zeros(m, dtype)
-            g = jnp.zeros(m + 1, dtype).at[0].set(beta)
-
-            def cond(c):
-                k, _, _, _, _, g, stop = c
-                return (k < m) & (jnp.abs(g[k]) > tol) & ~stop
-
-            def body(c):
-                k, basis, hess, cs, sn, g, _ = c
-                w = mv(basis[k])
-                live = (jnp.arange(m + 1) <= k).astype(dtype)
-                # classical Gram-Schmidt, twice (as stable as modified Gram-Schmidt, vectorised)
-                h = (basis @ w) * live
-                w = w - h @ basis
-                h2 = (basis @ w) * live
-                w = w - h2 @ basis
-                h = h + h2
-                hn = jnp.linalg.norm(w)
-                happy = hn <= 1e-14 * jnp.maximum(beta, 1e-300)  # Krylov space exhausted: exact
-                basis = basis.at[k + 1].set(jnp.where(happy, 0.0, w / jnp.where(happy, 1.0, hn)))
-                h = h.at[k + 1].set(hn)
-
-                # the k earlier rotations (a loop of k, not of the cycle's m: most cycles end
-                # after a few vectors), then a new one that zeroes h[k+1]
-                def rotate(i, h):
-                    hi, hj = h[i], h[i + 1]
-                    return (
-                        h.at[i].set(cs[i] * hi + sn[i] * hj).at[i + 1].set(-sn[i] * hi + cs[i] * hj)
-                    )
-
-                h = jax.lax.fori_loop(0, k, rotate, h)
-                c_k, s_k = _givens(h[k], h[k + 1])
-                h = h.at[k].set(c_k * h[k] + s_k * h[k + 1]).at[k + 1].set(0.0)
-                g = g.at[k + 1].set(-s_k * g[k]).at[k].set(c_k * g[k])
-                hess = hess.at[:, k].set(h)
-                return k + 1, basis, hess, cs.at[k].set(c_k), sn.at[k].set(s_k), g, happy
-
-            stop0 = beta <= tol
-            k, basis, hess, _, _, g, _ = jax.lax.while_loop(
-                cond, body, (jnp.asarray(0), basis, hess, cs, sn, g, stop0)
+        # One loop, one product with the operator per iteration: the vector it multiplies is the
+        # next Krylov vector (an Arnoldi step) or, at the end of a cycle, the iterate (the true
+        # residual b − A x, which also starts the next cycle). The operator (a linearised or
+        # transposed fixed-point map, large) thus appears once in the program, not once per use.
+        def new_cycle(r, r_norm):
+            basis = jnp.zeros((m + 1, n), dtype).at[0].set(r / jnp.where(r_norm > 0, r_norm, 1.0))
+            return (
+                basis,
+                jnp.zeros((m + 1, m), dtype),
+                jnp.ones(m, dtype),
+                jnp.zeros(m, dtype),
+                jnp.zeros(m + 1, dtype).at[0].set(r_norm),
+                jnp.asarray(0),
+                r_norm,
             )
-            # upper-triangular solve on the k columns used (unused ones: identity, zero rhs)
+
+        def arnoldi(carry, w):
+            x, (basis, hess, cs, sn, g, k, beta), _, res, cycles, steps, _ = carry
+            live = (jnp.arange(m + 1) <= k).astype(dtype)
+            # classical Gram-Schmidt, twice (as stable as modified Gram-Schmidt, vectorised)
+            h = (basis @ w) * live
+            w = w - h @ basis
+            h2 = (basis @ w) * live
+            w = w - h2 @ basis
+            h = h + h2
+            hn = jnp.linalg.norm(w)
+            happy = hn <= 1e-14 * jnp.maximum(beta, 1e-300)  # Krylov space exhausted: exact
+            basis = basis.at[k + 1].set(jnp.where(happy, 0.0, w / jnp.where(happy, 1.0, hn)))
+            h = h.at[k + 1].set(hn)
+
+            # the k earlier rotations (a loop of k, not of the cycle's m: most cycles end after a
+            # few vectors), then a new one that zeroes h[k+1]
+            def rotate(i, h):
+                hi, hj = h[i], h[i + 1]
+                return h.at[i].set(cs[i] * hi + sn[i] * hj).at[i + 1].set(-sn[i] * hi + cs[i] * hj)
+
+            h = jax.lax.fori_loop(0, k, rotate, h)
+            c_k, s_k = _givens(h[k], h[k + 1])
+            h = h.at[k].set(c_k * h[k] + s_k * h[k + 1]).at[k + 1].set(0.0)
+            g = g.at[k + 1].set(-s_k * g[k]).at[k].set(c_k * g[k])
+            hess = hess.at[:, k].set(h)
+            cs, sn, k = cs.at[k].set(c_k), sn.at[k].set(s_k), k + 1
+            # the cycle ends at m vectors, at the tolerance, or with the Krylov space exhausted:
+            # x += V y, y from the upper-triangular system on the k columns used (unused ones:
+            # identity, zero right-hand side)
+            end = (k >= m) | ~(jnp.abs(g[k]) > tol) | happy
             used = jnp.arange(m) < k
-            r = hess[:m, :m]
-            r = jnp.where(used[:, None] & used[None, :], r, jnp.eye(m, dtype=dtype))
+            r = jnp.where(used[:, None] & used[None, :], hess[:m, :m], jnp.eye(m, dtype=dtype))
             diag_ok = jnp.abs(jnp.diagonal(r)) > 0
             r = jnp.where(jnp.eye(m, dtype=bool) & ~diag_ok[:, None], 1.0, r)
             y = jax.scipy.linalg.solve_triangular(r, jnp.where(used, g[:m], 0.0), lower=False)
-            return x0 + y @ basis[:m], k
+            x = jnp.where(end, x + y @ basis[:m], x)
+            cycle = (basis, hess, cs, sn, g, k, beta)
+            return x, cycle, ~end, res, cycles, steps + 1, jnp.asarray(False)
 
-        def outer_cond(c):
-            _, res, i, _ = c
-            return (res > tol) & (i < self.max_restarts)
+        def residual(carry, w):
+            x, cycle, _, _, cycles, steps, _ = carry
+            r = b - w
+            res = jnp.linalg.norm(r)
+            # another cycle only while the residual is above the tolerance (False for NaN)
+            go = (res > tol) & (cycles < self.max_restarts)
+            cycle = jax.lax.cond(go, lambda: new_cycle(r, res), lambda: cycle)
+            return x, cycle, go, res, cycles + go.astype(cycles.dtype), steps, ~go
 
-        def outer_body(c):
-            x, _, i, steps = c
-            x, k = cycle(x)
-            return x, jnp.linalg.norm(b - mv(x)), i + 1, steps + k
+        def body(carry):
+            x, cycle, in_arnoldi = carry[0], carry[1], carry[2]
+            basis, k = cycle[0], cycle[5]
+            w = mv(jnp.where(in_arnoldi, basis[jnp.minimum(k, m)], x))
+            return jax.lax.cond(in_arnoldi, arnoldi, residual, carry, w)
 
-        x, res, _, steps = jax.lax.while_loop(
-            outer_cond,
-            outer_body,
-            (jnp.zeros_like(b), jnp.linalg.norm(b), jnp.asarray(0), jnp.asarray(0)),
+        # x0 = 0: the first residual is b itself, no product needed
+        go = (b_norm > tol) & (self.max_restarts > 0)
+        init = (
+            jnp.zeros_like(b),
+            new_cycle(b, b_norm),
+            go,
+            b_norm,
+            go.astype(jnp.int32),
+            jnp.asarray(0),
+            ~go,
         )
+        x, _, _, res, _, steps, _ = jax.lax.while_loop(lambda c: ~c[6], body, init)
         ok = res <= tol
         if self.nan_on_failure:
             # a derivative that cannot be computed is NaN, never an exception from inside a
