@@ -82,7 +82,7 @@ def enable_fast_cpu_compilation() -> bool:
     run it in about 0.7, with results equal to the fixed point's tolerance
     (``benchmarks/compile.py``); the tests use them, and the CLI does unless its ``--fidelity``
     is ``paper`` or ``paper_calibrated``: the paper fidelity's programs compile more slowly with
-    them (a tribo-dynamic point: ~1.7 times; ``benchmarks/paper_point.py`` with and without the
+    them (a tribo-dynamic point: ~1.4 times; ``benchmarks/paper_point.py`` with and without the
     flag) and run no faster.
 
     Takes effect only before JAX starts its CPU backend (the first computation). Leaves
