@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 
@@ -274,6 +275,19 @@ def _contact_indicator(model: EHLModel, sc: _Scales, big_h):
     below ``contact_threshold`` × the smooth central-film estimate, 0 above twice that."""
     hc = model.contact_threshold * sc.h_ref
     return 0.5 * (1.0 - jnp.tanh(4.0 * (big_h - 1.5 * hc) / hc))
+
+
+def _solution_structure(model: EHLModel, mixed: str, inp: _Inputs):
+    """The structure (shapes, dtypes) of the ``EHLSolution`` a solve of ``inp`` returns, found
+    without tracing the solve: its unknowns are shaped as the Hertzian start of the fine grid."""
+
+    def solution():
+        theta = dataclasses.replace(inp, rough=True) if mixed == "deterministic" else inp
+        u = _hertz_start(_fine_level(model, theta)[1])
+        one = jnp.ones((), u.dtype)
+        return _postprocess(model, mixed, inp, u, one, one, one)
+
+    return eqx.filter_eval_shape(solution)
 
 
 def _postprocess(model: EHLModel, mixed: str, inp: _Inputs, u, res, it, ok) -> EHLSolution:

@@ -11,7 +11,14 @@ import jax
 import jax.numpy as jnp
 
 from .. import thermal as thermal_mod
-from .core import SKIP_HOT, SKIP_NONE, SKIP_WARM, _postprocess, _solve_core
+from .core import (
+    SKIP_HOT,
+    SKIP_NONE,
+    SKIP_WARM,
+    _postprocess,
+    _solution_structure,
+    _solve_core,
+)
 from .model import EHLModel, _Inputs
 from .solution import EHLSolution
 from .starts import _warm_args
@@ -138,8 +145,7 @@ def _solve_and_update(
         skip = jnp.where(first, first_skip, SKIP_NONE).astype(inp_k.temperature_rise.dtype)
         u, res, it, ok = _solve_core(model, True, mixed, inp_k, *args_k, skip)
         new = _postprocess(model, mixed, inp_k, u, res, it, ok)
-        if sol_prev is not None:  # None: the placeholder's structure is being found
-            new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol_prev.iterations)
+        new = eqx.tree_at(lambda s: s.iterations, new, new.iterations + sol_prev.iterations)
         # a deterministic film whose re-solve failed (every attempt) ends the iteration, reported
         # not converged: the temperatures of a film that is not a Reynolds solution lead nowhere,
         # and each further re-solve runs every cold attempt (~500 Newton iterations each): a
@@ -190,16 +196,7 @@ def _solve_and_update(
     first = jnp.asarray(True)
     # what the first step replaces: a solution of the right structure, never read but for its
     # iteration count (0)
-    if cold:
-
-        def cold_solution():
-            none = jnp.asarray(SKIP_NONE, inp.temperature_rise.dtype)
-            u, res, it, ok = _solve_core(model, False, mixed, inp, *args, none)
-            return _postprocess(model, mixed, inp, u, res, it, ok)
-
-        shape = eqx.filter_eval_shape(cold_solution)
-    else:
-        shape = eqx.filter_eval_shape(lambda: solve(None, inp, args, first)[0])
+    shape = _solution_structure(model, mixed, inp)
     placeholder = jax.tree_util.tree_map(lambda a: jnp.zeros(a.shape, a.dtype), shape)
     if cold:  # a warm start of the right structure (guarded: finite), never read
         args = _warm_args(placeholder, det)
