@@ -171,8 +171,18 @@ def _merit_and_gradient(problem, u, multipliers, rho, limits):
     }
 
 
-#: One compiled program per problem structure (fidelity, objective, constraint names, shapes).
-merit_and_gradient = eqx.filter_jit(_merit_and_gradient)
+_merit_and_gradient_jit = eqx.filter_jit(_merit_and_gradient)
+
+
+def merit_and_gradient(problem, u, multipliers, rho, limits):
+    """The augmented Lagrangian, its gradient in u and its parts (a dict: merit, gradient,
+    objective, constraints, peaks, status), from one compiled program per problem structure
+    (fidelity, objective, constraint names, shapes). The numbers are taken as arrays of the
+    default float dtype whatever the caller passes (a Python or NumPy scalar, an array): a weakly
+    typed one would compile the program a second time."""
+    dtype = jnp.result_type(float)
+    numbers = (jnp.asarray(x, dtype=dtype) for x in (u, multipliers, rho, limits))
+    return _merit_and_gradient_jit(problem, *numbers)
 
 
 def batch_point(point, problem):

@@ -157,6 +157,30 @@ def test_per_gear_relief_and_step_cap():
     assert r0.evaluations == 1 and r0.objective_value == r0.objective_start
 
 
+def test_a_search_traces_its_merit_program_once(monkeypatch):
+    # the start, every step of the search and the final evaluation run one compiled program: the
+    # numbers it is given (a Python float penalty at the start, NumPy scalars later) must not
+    # change its input types (a weakly typed scalar traced and compiled it a second time, ~18 s
+    # on the tribo-dynamic rung). A fresh jit of the same function counts its traces.
+    import equinox as eqx
+
+    from jaxgear.design import problem as problem_mod
+
+    traces = []
+
+    def counted(*args):
+        traces.append(1)
+        return problem_mod._merit_and_gradient(*args)
+
+    monkeypatch.setattr(problem_mod, "_merit_and_gradient_jit", eqx.filter_jit(counted))
+    r = jg.optimise_tip_relief(
+        jg.presets.li2015_pair(), LUB, SURF, OP, speeds_rpm=SPEEDS[:1], fidelity=QS,
+        max_evaluations=4,
+    )  # fmt: skip
+    assert r.evaluations >= 2
+    assert len(traces) == 1
+
+
 def test_shape_both_returns_the_better():
     kw = dict(speeds_rpm=SPEEDS, fidelity=QS, max_evaluations=30)
     pair = jg.presets.li2015_pair()
