@@ -4,10 +4,20 @@ import jax
 import pytest
 
 from jaxgear.cli import enable_compilation_cache, enable_fast_cpu_compilation
+from jaxgear.cli.main import _jaxlib_knows
 
 # XLA's classic CPU emitters, as the CLI uses them (about half the compile time of the fusion
 # emitters on these programs); set before the first computation starts the backend.
 enable_fast_cpu_compilation()
+# ... and without LLVM's optimisation of the machine code (XLA's backend level 0 instead of its
+# default 3): the default run is mostly compilation, which this cuts by about a third (9.5 against
+# 13.3 min from an empty cache on 2 cores), for slower code where a test runs long. The numbers
+# differ from the optimised code's by round-off only, which
+# tests/cli/test_xla_flags.py checks against a process compiling as users do. A caller's own
+# level in $XLA_FLAGS is kept.
+_TEST_OPT_LEVEL = "xla_backend_optimization_level"
+if _TEST_OPT_LEVEL not in os.environ.get("XLA_FLAGS", "") and _jaxlib_knows(_TEST_OPT_LEVEL):
+    os.environ["XLA_FLAGS"] = f"{os.environ.get('XLA_FLAGS', '')} --{_TEST_OPT_LEVEL}=0".strip()
 # Tests run in float64 (EHL needs it); the library never flips this itself.
 jax.config.update("jax_enable_x64", True)
 # Compiled programs on disk from the first test on, as `jaxgear` keeps them ($JAXGEAR_CACHE_DIR,
