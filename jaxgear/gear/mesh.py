@@ -7,6 +7,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
+from .._inputs import canonical
 from .._validation import check_instance, check_positive, check_range
 from ..material import reduced_modulus
 from .geometry import GearGeometry, gear_geometry, normal_load, radii_of_curvature
@@ -149,6 +150,8 @@ def _checked(pair, torque, n_positions, stiffness, edge_width, relief_smoothing,
         raise ValueError(
             f"stiffness = {stiffness!r} is not valid; valid choices: {STIFFNESS_METHODS}"
         )
+    # float leaves become strong float64 arrays: one compiled cycle whatever the caller passed
+    pair = canonical(pair)
     return (
         pair,
         jnp.asarray(torque, dtype=pair.module.dtype),

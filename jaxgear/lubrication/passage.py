@@ -34,6 +34,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
+from .._inputs import canonical
 from .._validation import is_concrete
 from ..material import steel
 from . import thermal as thermal_mod
@@ -491,6 +492,8 @@ def solve_ehl_passage(
     if is_concrete(times) and not bool(jnp.all(jnp.diff(times) > 0)):
         raise ValueError("times are not increasing; valid: strictly increasing times, s")
     solids = (steel(), steel()) if solids is None else tuple(solids)
+    # float leaves become strong float64 arrays: one compiled passage whatever the caller passed
+    lubricant, surfaces, solids = canonical((lubricant, surfaces, solids))
     mixed = "smooth" if surfaces is None else model.mixed
     # the steps of a passage do not end in the pseudo-time march of a steady deterministic film
     # (``ehl.continuation._pseudo_march``): along an engagement it rescues no failed step and

@@ -9,6 +9,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
+from ..._inputs import canonical
 from ..._validation import check_positive
 from ..lubricant import Lubricant
 from .discretisation import _film_at_feet, _grid_positions, _roughness_offset, transport_shift
@@ -90,6 +91,11 @@ def solve_ehl(
             )
         check_positive("time_step", time_step, "s")
     mixed = "smooth" if surfaces is None else model.mixed
+    # float leaves become strong float64 arrays (a weakly typed one, from a Python float through
+    # eqx.tree_at, compiles the call below a second time)
+    contact, lubricant, surfaces, solids, initial, previous = canonical(
+        (contact, lubricant, surfaces, solids, initial, previous)
+    )
     # numbers become arrays (a Python float would be a static argument of the compiled call below,
     # one compilation per value)
     time_step, displacement, temperature_rise = (
