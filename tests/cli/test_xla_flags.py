@@ -134,10 +134,11 @@ def round_off_values() -> dict:
 # a fresh process compiling as users do: XLA_FLAGS without the tests' optimisation level
 _OPTIMISED = """
 import json, sys
-from jaxgear.cli import enable_fast_cpu_compilation
+from jaxgear.cli import enable_compilation_cache, enable_fast_cpu_compilation
 enable_fast_cpu_compilation()
 import jax
 jax.config.update("jax_enable_x64", True)
+enable_compilation_cache()
 sys.path[:0] = [{tests!r}, {here!r}]
 from test_xla_flags import round_off_values
 print(json.dumps(round_off_values()))
@@ -157,7 +158,8 @@ def test_the_tests_unoptimised_code_computes_what_the_users_optimised_code_does(
     assert mine != users or not cli_main._jaxlib_knows("xla_backend_optimization_level")
     here = os.path.dirname(os.path.abspath(__file__))
     code = _OPTIMISED.format(tests=os.path.dirname(here), here=here)
-    env = dict(os.environ, XLA_FLAGS=users, JAXGEAR_CACHE_DIR="off")
+    # the tests' on-disk cache (its keys include the XLA flags: no program is shared)
+    env = dict(os.environ, XLA_FLAGS=users)
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr[-2000:]
     optimised = json.loads(out.stdout.strip().splitlines()[-1])
