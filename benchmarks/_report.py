@@ -138,3 +138,20 @@ def bands(speeds, mask) -> str:
             runs.append(f"{a:.0f}" if a == b else f"{a:.0f}-{b:.0f}")
             start = None
     return ", ".join(runs) or "none"
+
+
+def run_probe(code: str, root: Path, env: dict) -> dict:
+    """Run ``python -c code`` in a fresh process in ``root`` with ``env`` and return the JSON that
+    it prints on a line starting with "RESULT " (a probe's measurements, free of this process's
+    compiled programs and JAX settings)."""
+    import json
+    import subprocess
+    import sys
+
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
+    )
+    for line in proc.stdout.splitlines():
+        if line.startswith("RESULT "):
+            return json.loads(line[7:])
+    raise RuntimeError(f"probe in {root} failed:\n{proc.stderr[-3000:]}")

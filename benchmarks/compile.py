@@ -128,13 +128,9 @@ def probe(root: Path, classic: bool = False) -> dict:
         "JAXGEAR_CACHE_DIR": "off",
         "JAX_COMPILATION_CACHE_DIR": "",
     }
-    proc = subprocess.run(
-        [sys.executable, "-c", PROBE], cwd=root, env=env, capture_output=True, text=True
-    )
-    for line in proc.stdout.splitlines():
-        if line.startswith("RESULT "):
-            return json.loads(line[7:])
-    raise RuntimeError(f"probe in {root} failed:\n{proc.stderr[-3000:]}")
+    from _report import run_probe
+
+    return run_probe(PROBE, root, env)
 
 
 def jaxgear_run(root: Path, classic: bool = False) -> float:

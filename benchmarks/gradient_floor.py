@@ -20,9 +20,7 @@ Writes the section ``gradient_floor`` of benchmarks/RESULTS.md. Run from the rep
 
 from __future__ import annotations
 
-import json
 import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -84,13 +82,9 @@ def probe(classic: bool) -> dict:
         "JAXGEAR_CACHE_DIR": "off",
         "JAX_COMPILATION_CACHE_DIR": "",
     }
-    proc = subprocess.run(
-        [sys.executable, "-c", PROBE], cwd=ROOT, env=env, capture_output=True, text=True
-    )
-    for line in proc.stdout.splitlines():
-        if line.startswith("RESULT "):
-            return json.loads(line[7:])
-    raise RuntimeError(f"probe failed:\n{proc.stderr[-3000:]}")
+    from _report import run_probe
+
+    return run_probe(PROBE, ROOT, env)
 
 
 def main():

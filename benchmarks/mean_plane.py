@@ -15,14 +15,12 @@ Run: ``python benchmarks/mean_plane.py [--old ../old]`` (writes its section of R
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import subprocess
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import machine, write_section  # noqa: E402
+from _report import machine, run_probe, write_section  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -70,13 +68,7 @@ print("RESULT " + json.dumps(out))
 
 def probe(root: Path) -> dict:
     env = {**os.environ, "PYTHONPATH": str(root), "JAXGEAR_CACHE_DIR": "off"}
-    proc = subprocess.run(
-        [sys.executable, "-c", PROBE], cwd=root, env=env, capture_output=True, text=True
-    )
-    for line in proc.stdout.splitlines():
-        if line.startswith("RESULT "):
-            return json.loads(line[7:])
-    raise RuntimeError(f"probe in {root} failed:\n{proc.stderr[-3000:]}")
+    return run_probe(PROBE, root, env)
 
 
 def main():
