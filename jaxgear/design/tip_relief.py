@@ -350,7 +350,7 @@ def normalise_objective(problem, u0, limits_array):
     n_con = constraint_count(problem, limits_array)
     zeros = jnp.zeros(n_con)
     # λ = 0 and a vanishing ρ: the merit's gradient is the objective's alone
-    out = merit_and_gradient(problem, jnp.asarray(u0), zeros, jnp.asarray(1e-12), limits_array)
+    out = merit_and_gradient(problem, u0, zeros, 1e-12, limits_array)
     value = float(out["objective"])
     if problem.epigraph:
         scaled = eqx.tree_at(lambda p: (p.reference, p.scale), problem,
@@ -448,15 +448,15 @@ def _solve(problem, names, x0, limits, op, *, ctol, gtol, max_evaluations):
         return result_from(problem, outcome, start_out, names, x0, limits, op, start_out)
 
     def evaluate(u, lam, rho, active):
-        out = merit_and_gradient(problem, jnp.asarray(u[0]), jnp.asarray(lam[0]),
-                                 jnp.asarray(rho[0]), limits_array)  # fmt: skip
+        out = merit_and_gradient(problem, u[0], lam[0], rho[0], limits_array)
         return [evaluation(out)]
 
     search = al.search(u0, n_con, ctol=ctol, gtol=gtol, max_evaluations=max_evaluations)
     outcome = al.drive([search], evaluate)[0]
     # the optimum's per-point values (one evaluation more: the search keeps only the merit's parts)
-    final_out = merit_and_gradient(problem, jnp.asarray(outcome.u), jnp.asarray(
-        outcome.multipliers), jnp.asarray(max(outcome.rho, 1.0)), limits_array)  # fmt: skip
+    final_out = merit_and_gradient(
+        problem, outcome.u, outcome.multipliers, max(outcome.rho, 1.0), limits_array
+    )
     return result_from(problem, outcome, start_out, names, x0, limits, op, final_out)
 
 
